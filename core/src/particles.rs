@@ -1,0 +1,439 @@
+//! Particle machinery shared by every particle filter: resampling into a caller-provided
+//! ancestor buffer, in-place gather of states, effective sample size.
+//!
+//! Resampling works in exact integer arithmetic: weights are quantised once to
+//! `q_i = floor(w_i * 2^31 / sum w)` (so `T = sum q_i < 2^32`), and every comparison
+//! `position < cumulative` is done on `u64` numerators. The result is the same on every
+//! target, has no floating-point drift over thousands of particles, and systematic and
+//! residual counts are provably within one of `M q_i / T`. A weight below `2^-31` of the
+//! total is quantised to zero (it would get a copy with probability below `M 2^-31`).
+//!
+//! All schemes write **sorted** ancestor indices (`a_0 <= a_1 <= ...`), which is what
+//! lets [`gather_in_place`] reorder the states without a second buffer.
+
+use crate::math::{self, KahanSum};
+use crate::rng::Rng;
+use crate::{Error, Result};
+
+/// An integer type that can hold a particle index (`u16` halves the RAM of `u32`).
+pub trait ParticleIndex: Copy + Default + core::fmt::Debug {
+    /// `Some(i)` if `i` fits.
+    fn from_usize(i: usize) -> Option<Self>;
+    /// The index as `usize`.
+    fn to_usize(self) -> usize;
+}
+
+macro_rules! impl_index {
+    ($($t:ty),*) => {$(
+        impl ParticleIndex for $t {
+            #[inline]
+            fn from_usize(i: usize) -> Option<Self> {
+                <$t>::try_from(i).ok()
+            }
+            #[inline]
+            fn to_usize(self) -> usize {
+                self as usize
+            }
+        }
+    )*};
+}
+impl_index!(u16, u32, usize);
+
+/// Resampling scheme.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Scheme {
+    /// One uniform offset, `M` evenly spaced positions (lowest variance in practice).
+    #[default]
+    Systematic,
+    /// One uniform per stratum `[j/M, (j+1)/M)`.
+    Stratified,
+    /// `floor(M w_i)` deterministic copies, the rest systematically from the residuals.
+    Residual,
+    /// `M` independent draws from the categorical distribution (sorted by generating
+    /// uniform order statistics from exponential spacings, no extra memory).
+    Multinomial,
+}
+
+/// Quantised weights: the `2^31 / sum` scale and the integer total `T`.
+struct Quantised {
+    scale: f32,
+    total: u64,
+}
+
+#[inline]
+fn quantise(w: f32, scale: f32) -> u64 {
+    // w >= 0 and finite (checked); w * scale <= 2^31 (1 + eps).
+    (w * scale) as u64
+}
+
+fn prepare(weights: &[f32]) -> Result<Quantised> {
+    let sum = math::checked_weight_sum(weights)?;
+    let mut scale = 2_147_483_648.0f32 / sum;
+    if !scale.is_finite() {
+        // Subnormal sum: quantise relative to the largest weight instead.
+        return Err(Error::DegenerateWeights);
+    }
+    // Guard the rounding of `sum` so that T stays below 2^32.
+    scale *= 1.0 - 4.0 * f32::EPSILON;
+    let mut total = 0u64;
+    for &w in weights {
+        total += quantise(w, scale);
+    }
+    if total == 0 {
+        return Err(Error::DegenerateWeights);
+    }
+    Ok(Quantised { scale, total })
+}
+
+/// Resamples `out.len()` ancestors from `weights` (non-negative, need not be normalised).
+///
+/// `out` receives sorted indices into `weights`; `out.len()` may differ from
+/// `weights.len()`. Errors leave `out` unspecified and are: [`Error::Empty`],
+/// [`Error::NonFinite`], [`Error::NegativeWeight`], [`Error::DegenerateWeights`] (all
+/// zero, or a subnormal sum), [`Error::IndexOutOfRange`] if `I` cannot index
+/// `weights.len()` particles. The usual recovery for degenerate weights is to keep the
+/// particles with uniform weights; the detectors document theirs.
+pub fn resample<I: ParticleIndex>(
+    scheme: Scheme,
+    weights: &[f32],
+    out: &mut [I],
+    rng: &mut Rng,
+) -> Result<()> {
+    if weights.is_empty() {
+        return Err(Error::Empty);
+    }
+    if I::from_usize(weights.len() - 1).is_none() {
+        return Err(Error::IndexOutOfRange);
+    }
+    if out.is_empty() {
+        return Ok(());
+    }
+    let q = prepare(weights)?;
+    match scheme {
+        Scheme::Systematic => {
+            let a = (rng.next_u32() as u64 * q.total) >> 32;
+            walk(weights, &q, out, |_| a)
+        }
+        Scheme::Stratified => walk(weights, &q, out, |_| {
+            (rng.next_u32() as u64 * q.total) >> 32
+        }),
+        Scheme::Residual => residual(weights, &q, out, rng),
+        Scheme::Multinomial => multinomial(weights, &q, out, rng),
+    }
+}
+
+/// Shared walk of systematic and stratified resampling.
+///
+/// Position `j` is `(a_j + j T) / M` with `a_j in [0, T)`; with `C_i` the cumulative
+/// quantised weight, `j` goes to the first `i` with `a_j + j T < M C_i`.
+fn walk<I: ParticleIndex>(
+    weights: &[f32],
+    q: &Quantised,
+    out: &mut [I],
+    mut offset: impl FnMut(usize) -> u64,
+) -> Result<()> {
+    let m = out.len() as u64;
+    let n = weights.len();
+    let mut i = 0usize;
+    let mut cum_m = m * quantise(weights[0], q.scale);
+    for (j, slot) in out.iter_mut().enumerate() {
+        let pos = offset(j) + j as u64 * q.total;
+        while pos >= cum_m && i + 1 < n {
+            i += 1;
+            cum_m += m * quantise(weights[i], q.scale);
+        }
+        *slot = I::from_usize(i).ok_or(Error::IndexOutOfRange)?;
+    }
+    Ok(())
+}
+
+/// Residual resampling: `floor(M q_i / T)` copies of each particle, then the remaining
+/// `M_r` by a systematic pass over the residuals `R_i = M q_i mod T` (whose total is
+/// `M_r T`, so the systematic step is exactly `T`). One sorted pass.
+fn residual<I: ParticleIndex>(
+    weights: &[f32],
+    q: &Quantised,
+    out: &mut [I],
+    rng: &mut Rng,
+) -> Result<()> {
+    let m = out.len() as u64;
+    let t = q.total;
+    let mut pos = (rng.next_u32() as u64 * t) >> 32;
+    let mut cum_r = 0u64;
+    let mut k = 0usize;
+    let mut last_positive = 0usize;
+    for (i, &w) in weights.iter().enumerate() {
+        let mq = m * quantise(w, q.scale);
+        if mq > 0 {
+            last_positive = i;
+        }
+        let copies = mq / t;
+        cum_r += mq % t;
+        let mut emit = copies;
+        while pos < cum_r {
+            emit += 1;
+            pos += t;
+        }
+        let idx = I::from_usize(i).ok_or(Error::IndexOutOfRange)?;
+        for _ in 0..emit {
+            if let Some(slot) = out.get_mut(k) {
+                *slot = idx;
+                k += 1;
+            }
+        }
+    }
+    // Exact arithmetic makes k == M; this only guards the unreachable remainder.
+    let idx = I::from_usize(last_positive).ok_or(Error::IndexOutOfRange)?;
+    for slot in out.iter_mut().skip(k) {
+        *slot = idx;
+    }
+    Ok(())
+}
+
+/// Multinomial resampling with sorted output and no extra memory: the `M` sorted
+/// uniforms are `S_j / S_{M+1}` with `S` the partial sums of `M + 1` exponentials
+/// (Devroye 1986, V.2). The exponentials are drawn twice from a cloned stream (once for
+/// the total, once for the walk) so nothing is stored.
+fn multinomial<I: ParticleIndex>(
+    weights: &[f32],
+    q: &Quantised,
+    out: &mut [I],
+    rng: &mut Rng,
+) -> Result<()> {
+    let m = out.len();
+    let mut probe = rng.clone();
+    let mut total = KahanSum::new();
+    for _ in 0..=m {
+        total.add(probe.exponential());
+    }
+    let total = total.value();
+    let n = weights.len();
+    let mut i = 0usize;
+    let mut cum = quantise(weights[0], q.scale);
+    let mut s = KahanSum::new();
+    for slot in out.iter_mut() {
+        s.add(rng.exponential());
+        let u = (s.value() / total).min(1.0);
+        // Position in quantised units; the min() keeps it inside [0, T).
+        let pos = ((u as f64 * q.total as f64) as u64).min(q.total - 1);
+        while pos >= cum && i + 1 < n {
+            i += 1;
+            cum += quantise(weights[i], q.scale);
+        }
+        *slot = I::from_usize(i).ok_or(Error::IndexOutOfRange)?;
+    }
+    // Consume the last exponential so the stream advances identically to `probe`.
+    let _ = rng.exponential();
+    Ok(())
+}
+
+/// Reorders `states` so that `states[j] = old states[ancestors[j]]`, in place and in
+/// O(N), for **sorted** ancestors (what [`resample`] produces).
+///
+/// Two passes: ascending for the slots with `a_j >= j` (they read slots not yet
+/// written), then descending for those with `a_j < j` (they read slots that were either
+/// never written or only copied onto themselves). Errors: [`Error::LengthMismatch`],
+/// [`Error::IndexOutOfRange`], [`Error::UnsortedAncestors`] (checked before any write).
+pub fn gather_in_place<S: Copy, I: ParticleIndex>(states: &mut [S], ancestors: &[I]) -> Result<()> {
+    if states.len() != ancestors.len() {
+        return Err(Error::LengthMismatch {
+            expected: states.len(),
+            got: ancestors.len(),
+        });
+    }
+    let n = states.len();
+    let mut prev = 0usize;
+    for a in ancestors {
+        let a = a.to_usize();
+        if a >= n {
+            return Err(Error::IndexOutOfRange);
+        }
+        if a < prev {
+            return Err(Error::UnsortedAncestors);
+        }
+        prev = a;
+    }
+    for j in 0..n {
+        let a = ancestors[j].to_usize();
+        if a >= j {
+            states[j] = states[a];
+        }
+    }
+    for j in (0..n).rev() {
+        let a = ancestors[j].to_usize();
+        if a < j {
+            states[j] = states[a];
+        }
+    }
+    Ok(())
+}
+
+/// Effective sample size `(sum w)^2 / sum w^2` of non-negative weights (normalised or
+/// not). Returns 0 for an empty or all-zero slice, and for NaN/inf inputs.
+pub fn effective_sample_size(weights: &[f32]) -> f32 {
+    let mut s = KahanSum::new();
+    let mut s2 = KahanSum::new();
+    for &w in weights {
+        s.add(w);
+        s2.add(w * w);
+    }
+    let (s, s2) = (s.value(), s2.value());
+    if s2 > 0.0 && s.is_finite() && s2.is_finite() {
+        s * s / s2
+    } else {
+        0.0
+    }
+}
+
+/// Fixed-capacity particle storage: `N` states and their weights, with a sorted ancestor
+/// buffer for resampling. `I` is the index type (`u16` for `N <= 65 536`).
+#[derive(Debug, Clone)]
+pub struct ParticleSet<S: Copy, I: ParticleIndex, const N: usize> {
+    /// Particle states.
+    pub states: [S; N],
+    /// Particle weights (normalised after [`ParticleSet::normalize`]).
+    pub weights: [f32; N],
+    ancestors: [I; N],
+}
+
+impl<S: Copy, I: ParticleIndex, const N: usize> ParticleSet<S, I, N> {
+    /// `N` copies of `init` with uniform weights `1/N`.
+    pub fn new(init: S) -> Self {
+        Self {
+            states: [init; N],
+            weights: [1.0 / N as f32; N],
+            ancestors: [I::default(); N],
+        }
+    }
+
+    /// Normalises the weights in place; returns their previous sum.
+    pub fn normalize(&mut self) -> Result<f32> {
+        math::normalize_weights(&mut self.weights)
+    }
+
+    /// Resamples `N` particles from `N` by `scheme`, sets the weights to `1/N`, and
+    /// leaves the ancestor of each new particle in [`ParticleSet::ancestors`].
+    /// On error the particles are untouched.
+    pub fn resample(&mut self, scheme: Scheme, rng: &mut Rng) -> Result<()> {
+        resample(scheme, &self.weights, &mut self.ancestors, rng)?;
+        gather_in_place(&mut self.states, &self.ancestors)?;
+        self.weights = [1.0 / N as f32; N];
+        Ok(())
+    }
+
+    /// The ancestors written by the last [`ParticleSet::resample`].
+    pub fn ancestors(&self) -> &[I; N] {
+        &self.ancestors
+    }
+
+    /// Effective sample size of the current weights.
+    pub fn ess(&self) -> f32 {
+        effective_sample_size(&self.weights)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::vec;
+    use std::vec::Vec;
+
+    fn counts(idx: &[u32], n: usize) -> Vec<usize> {
+        let mut c = vec![0; n];
+        for &i in idx {
+            c[i as usize] += 1;
+        }
+        c
+    }
+
+    #[test]
+    fn all_schemes_sorted_and_complete() {
+        let w = [0.1f32, 0.0, 0.4, 0.2, 0.3];
+        let mut rng = Rng::seed_from_u64(1);
+        for s in [
+            Scheme::Systematic,
+            Scheme::Stratified,
+            Scheme::Residual,
+            Scheme::Multinomial,
+        ] {
+            let mut out = [0u32; 1000];
+            resample(s, &w, &mut out, &mut rng).unwrap();
+            assert!(out.windows(2).all(|p| p[0] <= p[1]), "{s:?}");
+            let c = counts(&out, 5);
+            assert_eq!(c[1], 0, "{s:?} picked a zero weight");
+            assert_eq!(c.iter().sum::<usize>(), 1000);
+        }
+    }
+
+    #[test]
+    fn systematic_counts_within_one() {
+        let w = [0.123f32, 0.377, 0.25, 0.05, 0.2];
+        let mut rng = Rng::seed_from_u64(9);
+        for m in [1usize, 7, 100, 6000] {
+            let mut out = vec![0u32; m];
+            resample(Scheme::Systematic, &w, &mut out, &mut rng).unwrap();
+            for (i, c) in counts(&out, 5).iter().enumerate() {
+                let e = m as f32 * w[i];
+                assert!(
+                    (*c as f32 - e).abs() < 1.0 + 1e-3,
+                    "m={m} i={i} c={c} e={e}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn gather_matches_copy() {
+        let anc = [0u16, 0, 1, 4, 4, 4, 6, 7];
+        let mut s = [10, 11, 12, 13, 14, 15, 16, 17];
+        let old = s;
+        gather_in_place(&mut s, &anc).unwrap();
+        for j in 0..8 {
+            assert_eq!(s[j], old[anc[j] as usize]);
+        }
+        assert_eq!(
+            gather_in_place(&mut s, &[1u16, 0, 2, 3, 4, 5, 6, 7]),
+            Err(Error::UnsortedAncestors)
+        );
+    }
+
+    #[test]
+    fn degenerate_weights_are_errors() {
+        let mut rng = Rng::seed_from_u64(0);
+        let mut out = [0u16; 4];
+        let e =
+            |w: &[f32], out: &mut [u16], rng: &mut Rng| resample(Scheme::Systematic, w, out, rng);
+        assert_eq!(
+            e(&[0.0; 4], &mut out, &mut rng),
+            Err(Error::DegenerateWeights)
+        );
+        assert_eq!(
+            e(&[1.0, f32::NAN], &mut out, &mut rng),
+            Err(Error::NonFinite)
+        );
+        assert_eq!(
+            e(&[1.0, -1.0], &mut out, &mut rng),
+            Err(Error::NegativeWeight)
+        );
+        assert_eq!(e(&[], &mut out, &mut rng), Err(Error::Empty));
+        assert_eq!(
+            e(&[1e-45; 4], &mut out, &mut rng),
+            Err(Error::DegenerateWeights)
+        );
+        let big = vec![1.0f32; 70_000];
+        assert_eq!(e(&big, &mut out, &mut rng), Err(Error::IndexOutOfRange));
+    }
+
+    #[test]
+    fn particle_set_resample() {
+        let mut p: ParticleSet<f32, u16, 64> = ParticleSet::new(0.0);
+        for i in 0..64 {
+            p.states[i] = i as f32;
+            p.weights[i] = if i == 10 { 1.0 } else { 0.0 };
+        }
+        let mut rng = Rng::seed_from_u64(5);
+        p.resample(Scheme::Systematic, &mut rng).unwrap();
+        assert!(p.states.iter().all(|&s| s == 10.0));
+        assert!((p.ess() - 64.0).abs() < 1e-3);
+    }
+}

@@ -1,0 +1,4 @@
+//! # faint-host
+//!
+//! The std side of faint: scenario simulators, the Monte Carlo runner, detection
+//! statistics, and CSV/JSON/plot output.
