@@ -1,0 +1,216 @@
+//! Stage 2, plot censoring (paper 003, §3.1): modified single-frame Hough transform
+//! (MSHT, eq. 4), M-scan sliding-window collinearity (eq. 5) and velocity gate (eq. 6).
+//!
+//! The rule implemented: a plot `s_{k,m}` joins the effective set `S_ep` when, for some
+//! window of `M` consecutive scans `n-M+1..=n` containing `m`, there is a chain of plots
+//! `p_{n-M+1}, ..., p_n` (one per scan of the window, `p_m = s_{k,m}`) such that
+//! 1. all of them lie on one Hough cell `(rho, theta)` (the cell is hit in every scan of
+//!    the window: `P_n(rho, theta) != 0`, eq. 5), and
+//! 2. each consecutive pair passes the gate `|p_j - p_{j+1}| <= V_max T_scan` (eq. 6).
+//!
+//! This is the paper's censoring with the chain reading of "plot pairs of a surviving cell
+//! between consecutive scans" (a plot must be linked through the whole window, not only to
+//! one neighbour scan). The MSHT's per-cell plot sets (eq. 4, Algorithm 1) are not stored:
+//! the plots of the last `M` scans are kept and cell membership is recomputed from their
+//! coordinates. Evaluation order is gate first, then collinearity: gated pairs between
+//! consecutive scans are found with an x-sorted sweep (`O(P log P)`), chains are grown
+//! through them, and each complete chain is tested for a common cell over the `A` angles.
+//! The output set is identical to "AND the `M` hit bitmaps, then gate the plots of each
+//! surviving cell" (`tests/mht_core.rs` checks it against that brute force), at a small
+//! fraction of its cost in dense clutter, where almost every cell is hit in every scan.
+
+use super::geometry::Geometry;
+use crate::model::plot::Plot;
+
+/// Largest supported window `M`.
+pub const MAX_M: usize = 8;
+
+/// Flag bit: the plot is in the effective set `S_ep`.
+pub const FLAG_EFFECTIVE: u8 = 1;
+
+/// Counters of one censoring step.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct CensorStats {
+    /// Gated pairs between the previous scan and this one.
+    pub pairs: u32,
+    /// Pairs dropped because the pair list (capacity `P`) was full.
+    pub pair_overflow: u32,
+    /// Complete chains tested for a common cell.
+    pub chains: u32,
+    /// Chains not tested because the per-scan chain budget was spent.
+    pub chain_overflow: u32,
+    /// Plots newly marked effective by this step's window.
+    pub newly_effective: u32,
+}
+
+/// Working memory of the censoring stage for scans of at most `P` plots.
+#[derive(Debug, Clone)]
+pub struct Censor<const P: usize> {
+    /// x-sorted plot indices of the scans, ring by scan index mod 2.
+    order: [[u16; P]; 2],
+    /// Gated pairs `(prev, cur)` between scan `s-1` and `s`, ring by `s mod MAX_M`,
+    /// sorted by `prev`.
+    pairs: [[(u16, u16); P]; MAX_M],
+    npairs: [u16; MAX_M],
+    /// Chain budget per step (`4 P`), bounds the worst-case cost.
+    chain_budget: u32,
+}
+
+impl<const P: usize> Default for Censor<P> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const P: usize> Censor<P> {
+    /// Empty working memory.
+    pub const fn new() -> Self {
+        Self {
+            order: [[0; P]; 2],
+            pairs: [[(0, 0); P]; MAX_M],
+            npairs: [0; MAX_M],
+            chain_budget: 4 * P as u32,
+        }
+    }
+
+    /// Process scan `s` of the block (`scans[s]` holds its plots): find gated pairs with
+    /// scan `s-1`, then, when `s >= m-1`, the chains of the window `s-m+1..=s`, marking
+    /// the plots of every collinear chain effective in `flags`.
+    ///
+    /// `m` must be in `3..=MAX_M` and `gate >= 0` (checked by the config).
+    pub fn step<const R: usize, const A: usize>(
+        &mut self,
+        geom: &Geometry<R, A>,
+        scans: &[&[Plot]],
+        flags: &mut [[u8; P]],
+        s: usize,
+        m: usize,
+        gate: f32,
+    ) -> CensorStats {
+        let mut st = CensorStats::default();
+        let Some(cur) = scans.get(s) else {
+            return st;
+        };
+        let n = cur.len().min(P);
+        // x-order of this scan
+        let ord = &mut self.order[s % 2];
+        for (i, o) in ord.iter_mut().enumerate().take(n) {
+            *o = i as u16;
+        }
+        ord[..n].sort_unstable_by(|&i, &j| cur[i as usize].x.total_cmp(&cur[j as usize].x));
+        let slot = s % MAX_M;
+        self.npairs[slot] = 0;
+        if s == 0 {
+            return st;
+        }
+        // gated pairs with the previous scan
+        let prev = scans[s - 1];
+        let np = prev.len().min(P);
+        let pord = &self.order[(s - 1) % 2][..np];
+        let g2 = gate * gate;
+        let list = &mut self.pairs[slot];
+        let mut k = 0usize;
+        for (qi, q) in cur.iter().enumerate().take(n) {
+            let lo = pord.partition_point(|&i| prev[i as usize].x < q.x - gate);
+            for &pi in &pord[lo..] {
+                let p = &prev[pi as usize];
+                if p.x > q.x + gate {
+                    break;
+                }
+                if p.dist2(q) <= g2 {
+                    if k < P {
+                        list[k] = (pi, qi as u16);
+                        k += 1;
+                    } else {
+                        st.pair_overflow += 1;
+                    }
+                }
+            }
+        }
+        list[..k].sort_unstable();
+        self.npairs[slot] = k as u16;
+        st.pairs = k as u32;
+        if s + 1 < m {
+            return st;
+        }
+        // chains through the window s0..=s
+        let s0 = s + 1 - m;
+        let mut chain = [0u16; MAX_M];
+        let mut pts = [(0i32, 0i32); MAX_M];
+        let first = (s0 + 1) % MAX_M;
+        let nfirst = usize::from(self.npairs[first]);
+        let mut budget = self.chain_budget;
+        for i in 0..nfirst {
+            let (a, b) = self.pairs[first][i];
+            chain[0] = a;
+            chain[1] = b;
+            self.grow(
+                geom,
+                scans,
+                flags,
+                s0,
+                m,
+                2,
+                &mut chain,
+                &mut pts,
+                &mut budget,
+                &mut st,
+            );
+        }
+        st
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn grow<const R: usize, const A: usize>(
+        &self,
+        geom: &Geometry<R, A>,
+        scans: &[&[Plot]],
+        flags: &mut [[u8; P]],
+        s0: usize,
+        m: usize,
+        len: usize,
+        chain: &mut [u16; MAX_M],
+        pts: &mut [(i32, i32); MAX_M],
+        budget: &mut u32,
+        st: &mut CensorStats,
+    ) {
+        if len == m {
+            if *budget == 0 {
+                st.chain_overflow += 1;
+                return;
+            }
+            *budget -= 1;
+            // all already effective: nothing to learn
+            if (0..m).all(|j| flags[s0 + j][usize::from(chain[j])] & FLAG_EFFECTIVE != 0) {
+                return;
+            }
+            st.chains += 1;
+            for j in 0..m {
+                let p = scans[s0 + j][usize::from(chain[j])];
+                pts[j] = geom.quantise(p.x, p.y);
+            }
+            if geom.share_cell(&pts[..m]) {
+                for j in 0..m {
+                    let f = &mut flags[s0 + j][usize::from(chain[j])];
+                    if *f & FLAG_EFFECTIVE == 0 {
+                        *f |= FLAG_EFFECTIVE;
+                        st.newly_effective += 1;
+                    }
+                }
+            }
+            return;
+        }
+        // pairs between scan s0+len-1 and s0+len, starting at chain[len-1]
+        let slot = (s0 + len) % MAX_M;
+        let list = &self.pairs[slot][..usize::from(self.npairs[slot])];
+        let last = chain[len - 1];
+        let lo = list.partition_point(|&(a, _)| a < last);
+        for &(a, b) in &list[lo..] {
+            if a != last {
+                break;
+            }
+            chain[len] = b;
+            self.grow(geom, scans, flags, s0, m, len + 1, chain, pts, budget, st);
+        }
+    }
+}

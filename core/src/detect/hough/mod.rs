@@ -1,0 +1,431 @@
+//! MHT-TBD: modified Hough transform track-before-detect for dense clutter
+//! (Bao, Lu, Tian, Tian, Acta Electronica Sinica 50(7), 2022; seed 003), and the classic
+//! Carlson Hough TBD baseline.
+//!
+//! Three stages (Fig. 1): pre-detection (outside this module: the input plots), plot
+//! censoring ([`censoring`]: MSHT + M-scan collinearity + velocity gate -> effective
+//! plots `S_ep`), detection and track recovery ([`dmht`]: data-matched Hough transform of
+//! `S_ep`, binary integration, 3x3 Gaussian smoothing, threshold `gamma_1`, condensing,
+//! line-to-plot association).
+//!
+//! Streaming: [`MhtTbd::step`] takes one scan. Integration periods are **blocked**: scans
+//! `0..N`, `N..2N`, ... form periods; the step that completes a period runs the DMHT and
+//! returns a [`Detection`] in its report; the tracks are then readable with
+//! [`MhtTbd::tracks`] until the next `step` starts a new period. Censoring windows do not
+//! cross period boundaries (the plots of a period are judged on that period's scans only,
+//! as the paper's model of a cell's `N`-scan hit sequence assumes).
+//!
+//! Bad input, all counted in the report, never a panic:
+//! - plots with NaN/inf fields or outside the surveillance area are skipped (`invalid`);
+//! - plots beyond the capacity `P` of a scan are skipped (`overflow`);
+//! - gated pairs beyond `P` per scan pair and chains beyond `4 P` per scan are skipped
+//!   ([`CensorStats`]); peaks beyond `T` are dropped weakest first ([`CondenseStats`]);
+//! - degenerate geometry (all effective plots at one point): the DMHT rho range is
+//!   floored at `drho_min` so the transform is defined (every curve passes through the
+//!   middle rho cell); a period without effective plots reports zero tracks;
+//! - zero scans per period, `M` outside `3..=8`, `N > NS` or `N > 64`, a non-finite or
+//!   empty area: [`Error::InvalidConfig`] at construction.
+//!
+//! Memory (all fixed at compile time): the period's plots `NS x P` (12 B each) plus one
+//! flag byte each, the censoring pair ring `8 x P x 4 B`, the accumulator `R x A x 4 B`
+//! and `T` tracks of `NS` indices.
+
+pub mod censoring;
+pub mod classic;
+pub mod dmht;
+pub mod geometry;
+
+pub use censoring::{CensorStats, MAX_M};
+pub use classic::{ClassicConfig, ClassicHough, ClassicReport};
+pub use dmht::{Accumulator, CondenseStats, Peak, Track, NO_PLOT};
+pub use geometry::Geometry;
+
+use crate::model::plot::Plot;
+use crate::{math, Error, Result};
+use censoring::{Censor, FLAG_EFFECTIVE};
+
+/// True when the plot is finite and inside `[x_min, x_max] x [y_min, y_max]`.
+#[inline]
+pub fn in_area(p: &Plot, area: [f32; 4]) -> bool {
+    p.x.is_finite()
+        && p.y.is_finite()
+        && p.x >= area[0]
+        && p.x <= area[1]
+        && p.y >= area[2]
+        && p.y <= area[3]
+}
+
+pub(crate) fn validate_area(area: [f32; 4]) -> Result<()> {
+    if area.iter().any(|v| !v.is_finite()) || area[1] <= area[0] || area[3] <= area[2] {
+        return Err(Error::InvalidConfig("area"));
+    }
+    Ok(())
+}
+
+/// Runtime configuration of MHT-TBD.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MhtConfig {
+    /// Surveillance area `[x_min, x_max, y_min, y_max]` (m).
+    pub area: [f32; 4],
+    /// Sliding-window length `M` (3..=8).
+    pub m: usize,
+    /// Scans per integration period `N` (`M..=min(NS, 64)`).
+    pub n_scans: usize,
+    /// Velocity gate `V_max T_scan` (m), eq. 6.
+    pub gate: f32,
+    /// Detection threshold `gamma_1` on the binary-integration count of a cell (the
+    /// smoothing only locates the peak, see [`Accumulator::condense`]).
+    pub gamma1: u8,
+    /// Apply the 3x3 Gaussian smoothing to locate the peaks.
+    pub smooth: bool,
+    /// Plot-to-line distance `D_max` (m), eq. 9.
+    pub d_max: f32,
+    /// Along-line gate around the track's predicted position (m).
+    pub along_gate: f32,
+    /// Look back into the pre-detection plots when no effective plot qualifies.
+    pub lookback: bool,
+    /// Tracks with fewer associated plots are not confirmed.
+    pub min_track_plots: u16,
+    /// Smallest DMHT rho half-range (m) (degenerate geometry).
+    pub drho_min: f32,
+}
+
+impl MhtConfig {
+    /// The paper's sea-clutter setting (§5.1): 6 km x 6 km, `N = 30`, `M = 3`,
+    /// `V_max T_scan = 20 m/s x 5 s = 100 m`, `gamma_1 = 22` (the paper's value at
+    /// `lambda ~ 398`; the host computes it from the model for a wanted `Pfa`).
+    pub const fn sea_clutter() -> Self {
+        Self {
+            area: [0.0, 6000.0, 0.0, 6000.0],
+            m: 3,
+            n_scans: 30,
+            gate: 100.0,
+            gamma1: 22,
+            smooth: true,
+            d_max: 30.0,
+            along_gate: 100.0,
+            lookback: true,
+            min_track_plots: 3,
+            drho_min: 50.0,
+        }
+    }
+
+    /// Check the values against the capacities `NS` (scans) of a detector.
+    pub fn validate(&self, ns: usize) -> Result<()> {
+        validate_area(self.area)?;
+        if !(3..=MAX_M).contains(&self.m) {
+            return Err(Error::InvalidConfig("m"));
+        }
+        if self.n_scans == 0 || self.n_scans < self.m || self.n_scans > ns || self.n_scans > 64 {
+            return Err(Error::InvalidConfig("n_scans"));
+        }
+        if !(self.gate.is_finite() && self.gate > 0.0) {
+            return Err(Error::InvalidConfig("gate"));
+        }
+        if self.gamma1 == 0 {
+            return Err(Error::InvalidConfig("gamma1"));
+        }
+        if !(self.d_max.is_finite() && self.d_max > 0.0) {
+            return Err(Error::InvalidConfig("d_max"));
+        }
+        if !(self.along_gate.is_finite() && self.along_gate > 0.0) {
+            return Err(Error::InvalidConfig("along_gate"));
+        }
+        if !(self.drho_min.is_finite() && self.drho_min > 0.0) {
+            return Err(Error::InvalidConfig("drho_min"));
+        }
+        Ok(())
+    }
+}
+
+/// Summary of one completed integration period.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Detection {
+    /// Plots kept over the period (pre-detection plots, after invalid/overflow).
+    pub pre_plots: u32,
+    /// Effective plots `|S_ep|`.
+    pub effective_plots: u32,
+    /// DMHT origin `(x0, y0)`: centroid of `S_ep` (eq. 7).
+    pub origin: (f32, f32),
+    /// DMHT rho cell size (m).
+    pub drho: f32,
+    /// Condensing counters.
+    pub condense: CondenseStats,
+    /// Confirmed tracks (see [`MhtTbd::tracks`]).
+    pub tracks: u16,
+    /// Peaks whose track had fewer than `min_track_plots` plots.
+    pub short: u16,
+    /// Peaks whose track shared more than half its plots with a stronger track.
+    pub merged: u16,
+}
+
+/// One step's report.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct MhtReport {
+    /// Index of this scan within its period.
+    pub scan_in_period: u16,
+    /// Plots offered.
+    pub plots_in: u32,
+    /// Plots kept.
+    pub plots_kept: u16,
+    /// Plots skipped: non-finite or outside the area.
+    pub invalid: u32,
+    /// Plots skipped: beyond the capacity `P`.
+    pub overflow: u32,
+    /// Censoring counters of this scan's window.
+    pub censor: CensorStats,
+    /// Set when this scan completed a period.
+    pub detection: Option<Detection>,
+}
+
+/// Streaming MHT-TBD detector: `P` plots per scan, `NS` scans per period at most, an
+/// `R x A` Hough grid, `T` tracks per period.
+#[derive(Debug, Clone)]
+pub struct MhtTbd<const P: usize, const NS: usize, const R: usize, const A: usize, const T: usize> {
+    cfg: MhtConfig,
+    msht: Geometry<R, A>,
+    dmht: Geometry<R, A>,
+    plots: [[Plot; P]; NS],
+    counts: [u16; NS],
+    flags: [[u8; P]; NS],
+    censor: Censor<P>,
+    acc: Accumulator<R, A>,
+    peaks: [Peak; T],
+    tracks: [Track<NS>; T],
+    ntracks: usize,
+    scan: usize,
+}
+
+impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: usize>
+    MhtTbd<P, NS, R, A, T>
+{
+    /// A detector for a configuration (validated here). The struct is large
+    /// (`~ NS P 13 + R A 4` bytes): box it on the host, make it `static` on a target.
+    pub fn new(cfg: MhtConfig) -> Result<Self> {
+        cfg.validate(NS)?;
+        if P > usize::from(u16::MAX) || P == 0 || T == 0 {
+            return Err(Error::InvalidConfig("capacity"));
+        }
+        Ok(Self {
+            cfg,
+            msht: Geometry::for_area(cfg.area),
+            dmht: Geometry::for_area(cfg.area),
+            plots: [[Plot::default(); P]; NS],
+            counts: [0; NS],
+            flags: [[0; P]; NS],
+            censor: Censor::new(),
+            acc: Accumulator::new(),
+            peaks: [Peak::default(); T],
+            tracks: [Track::default(); T],
+            ntracks: 0,
+            scan: 0,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &MhtConfig {
+        &self.cfg
+    }
+
+    /// Change `gamma_1` (takes effect at the next period end).
+    pub fn set_gamma1(&mut self, gamma1: u8) -> Result<()> {
+        if gamma1 == 0 {
+            return Err(Error::InvalidConfig("gamma1"));
+        }
+        self.cfg.gamma1 = gamma1;
+        Ok(())
+    }
+
+    /// Single-frame (MSHT) geometry: origin at the area centre.
+    pub fn msht_geometry(&self) -> &Geometry<R, A> {
+        &self.msht
+    }
+
+    /// DMHT geometry of the last completed period.
+    pub fn dmht_geometry(&self) -> &Geometry<R, A> {
+        &self.dmht
+    }
+
+    /// DMHT accumulator of the last completed period.
+    pub fn accumulator(&self) -> &Accumulator<R, A> {
+        &self.acc
+    }
+
+    /// Kept plots of scan `s` of the current (or just completed) period.
+    pub fn scan_plots(&self, s: usize) -> &[Plot] {
+        match (self.plots.get(s), self.counts.get(s)) {
+            (Some(p), Some(&n)) => &p[..usize::from(n)],
+            _ => &[],
+        }
+    }
+
+    /// True when plot `k` of scan `s` is in `S_ep`.
+    pub fn is_effective(&self, s: usize, k: usize) -> bool {
+        self.flags
+            .get(s)
+            .and_then(|f| f.get(k))
+            .is_some_and(|f| f & FLAG_EFFECTIVE != 0)
+    }
+
+    /// Number of effective plots in scan `s`.
+    pub fn effective_count(&self, s: usize) -> usize {
+        let n = self.counts.get(s).map_or(0, |&n| usize::from(n));
+        self.flags.get(s).map_or(0, |f| {
+            f[..n].iter().filter(|&&b| b & FLAG_EFFECTIVE != 0).count()
+        })
+    }
+
+    /// Confirmed tracks of the last completed period, strongest peak first.
+    pub fn tracks(&self) -> &[Track<NS>] {
+        &self.tracks[..self.ntracks]
+    }
+
+    /// Feed one scan of plots. See the module doc for the handling of bad plots.
+    pub fn step(&mut self, scan_plots: &[Plot]) -> Result<MhtReport> {
+        let s = self.scan;
+        if s == 0 {
+            self.counts = [0; NS];
+            self.ntracks = 0;
+        }
+        let mut rep = MhtReport {
+            scan_in_period: s as u16,
+            plots_in: scan_plots.len() as u32,
+            ..Default::default()
+        };
+        // copy valid plots into the period store
+        let mut n = 0usize;
+        for p in scan_plots {
+            if !in_area(p, self.cfg.area) || !p.amplitude.is_finite() {
+                rep.invalid += 1;
+            } else if n < P {
+                self.plots[s][n] = *p;
+                n += 1;
+            } else {
+                rep.overflow += 1;
+            }
+        }
+        self.counts[s] = n as u16;
+        self.flags[s][..n].fill(0);
+        rep.plots_kept = n as u16;
+        // stage 2: censoring of the window ending at s
+        {
+            let plots = &self.plots;
+            let counts = &self.counts;
+            let scans: [&[Plot]; NS] =
+                core::array::from_fn(|i| &plots[i][..usize::from(counts[i])]);
+            rep.censor = self.censor.step(
+                &self.msht,
+                &scans[..=s],
+                &mut self.flags,
+                s,
+                self.cfg.m,
+                self.cfg.gate,
+            );
+        }
+        self.scan += 1;
+        if self.scan == self.cfg.n_scans {
+            self.scan = 0;
+            rep.detection = Some(self.detect());
+        }
+        Ok(rep)
+    }
+
+    /// Stage 3 over the completed period.
+    fn detect(&mut self) -> Detection {
+        let ns = self.cfg.n_scans;
+        let mut det = Detection::default();
+        // centroid and extent of S_ep (f64-free: two-pass in f32 about the area centre)
+        let (ax, ay) = self.msht.origin();
+        let (mut sx, mut sy, mut ne) = (0.0f32, 0.0f32, 0u32);
+        for s in 0..ns {
+            let n = usize::from(self.counts[s]);
+            det.pre_plots += n as u32;
+            for k in 0..n {
+                if self.flags[s][k] & FLAG_EFFECTIVE != 0 {
+                    sx += self.plots[s][k].x - ax;
+                    sy += self.plots[s][k].y - ay;
+                    ne += 1;
+                }
+            }
+        }
+        det.effective_plots = ne;
+        self.acc.reset();
+        if ne == 0 {
+            self.dmht = Geometry::new(ax, ay, self.msht.rho_max());
+            det.origin = self.dmht.origin();
+            det.drho = self.dmht.drho();
+            return det;
+        }
+        let x0 = ax + sx / ne as f32;
+        let y0 = ay + sy / ne as f32;
+        let mut r2 = 0.0f32;
+        for s in 0..ns {
+            for k in 0..usize::from(self.counts[s]) {
+                if self.flags[s][k] & FLAG_EFFECTIVE != 0 {
+                    let p = self.plots[s][k];
+                    let d2 = (p.x - x0) * (p.x - x0) + (p.y - y0) * (p.y - y0);
+                    if d2 > r2 {
+                        r2 = d2;
+                    }
+                }
+            }
+        }
+        // 1 % margin so the farthest plot is not on the clamp edge
+        let rho_max = (math::sqrt(r2) * 1.01).max(self.cfg.drho_min);
+        self.dmht = Geometry::new(x0, y0, rho_max);
+        det.origin = (x0, y0);
+        det.drho = self.dmht.drho();
+        // binary integration of S_ep (eq. 7)
+        for s in 0..ns {
+            let tag = (s + 1) as u8;
+            for k in 0..usize::from(self.counts[s]) {
+                if self.flags[s][k] & FLAG_EFFECTIVE != 0 {
+                    let p = self.plots[s][k];
+                    self.acc.add_point(&self.dmht, tag, p.x, p.y);
+                }
+            }
+        }
+        self.acc.finish(self.cfg.smooth);
+        det.condense = self.acc.condense(self.cfg.gamma1, &mut self.peaks);
+        // track recovery
+        let assoc = dmht::Assoc {
+            d_max: self.cfg.d_max,
+            along_gate: self.cfg.along_gate,
+            lookback: self.cfg.lookback,
+        };
+        let plots = &self.plots;
+        let counts = &self.counts;
+        let scans: [&[Plot]; NS] = core::array::from_fn(|i| &plots[i][..usize::from(counts[i])]);
+        let mut nt = 0usize;
+        for i in 0..usize::from(det.condense.peaks) {
+            let mut tr = Track::<NS>::default();
+            dmht::recover::<R, A, P, NS>(
+                &self.dmht,
+                self.peaks[i],
+                &scans[..ns],
+                &self.flags,
+                &assoc,
+                &mut tr,
+            );
+            if tr.n_plots < self.cfg.min_track_plots {
+                det.short += 1;
+                continue;
+            }
+            let dup = self.tracks[..nt].iter().any(|o| {
+                let shared = (0..ns)
+                    .filter(|&s| tr.plots[s] != NO_PLOT && tr.plots[s] == o.plots[s])
+                    .count();
+                2 * shared > usize::from(tr.n_plots)
+            });
+            if dup {
+                det.merged += 1;
+                continue;
+            }
+            self.tracks[nt] = tr;
+            nt += 1;
+        }
+        self.ntracks = nt;
+        det.tracks = nt as u16;
+        det
+    }
+}

@@ -1,0 +1,2 @@
+//! Detectors, one module per family.
+pub mod hough;

@@ -1,0 +1,2 @@
+//! Observation models: the per-frame inputs detectors consume.
+pub mod plot;

@@ -1,0 +1,2 @@
+//! Closed-form detection models.
+pub mod hough_model;

@@ -1,0 +1,2 @@
+//! One reproduction per paper.
+pub mod mht;

@@ -1,0 +1,2 @@
+//! Scenario simulators, one module per paper's scene.
+pub mod sea_clutter;
