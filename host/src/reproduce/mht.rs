@@ -4,7 +4,9 @@
 //! Scoring (documented choices):
 //! - a reported track (MHT: a confirmed track's line; classic: a peak's line) **matches**
 //!   target `i` when every noise-free position of the target over the `N` scans lies
-//!   within `MATCH_TOL` of the line; a target is detected when some track matches it;
+//!   within `MATCH_TOL` of the line, or (MHT only, its tracks carry plots) when more than
+//!   half of the track's plots are target `i`'s; a target is detected when some track
+//!   matches it;
 //!   a track matching no target is a **false alarm** (a second track on the same target is
 //!   a duplicate, not a false alarm);
 //! - plot-loss rate: over detected targets, the target's pre-detection plots missing from
@@ -169,8 +171,19 @@ pub fn evaluate_trial(
     let tracks = mht.tracks();
     let mut matched = vec![false; nt];
     for tr in tracks {
+        let n_of = |i: usize| {
+            (0..trial.scans.len())
+                .filter(|&s| {
+                    tr.plots[s] != NO_PLOT
+                        && trial.scans[s].origin[usize::from(tr.plots[s])] == Origin::Target(i)
+                })
+                .count()
+        };
         let hits: Vec<usize> = (0..nt)
-            .filter(|&i| line_matches(tr.theta, tr.c, trial, i, sc.t_scan))
+            .filter(|&i| {
+                line_matches(tr.theta, tr.c, trial, i, sc.t_scan)
+                    || 2 * n_of(i) > usize::from(tr.n_plots)
+            })
             .collect();
         if hits.is_empty() {
             st.mht_false += 1;

@@ -308,13 +308,89 @@ fn fit(ts: &[(f32, f32)]) -> Option<(f32, f32)> {
     Some((mt - beta * ms, beta))
 }
 
+/// Consensus fit of `t = alpha + beta s`: every pair of points with `|beta| <= gate`
+/// proposes a line, the one with most points within `gate` wins (ties: first), and the
+/// least-squares fit of its inliers is returned. Robust to clutter plots far along the
+/// line. `O(n^3)` with `n <= NS`.
+fn fit_consensus(ts: &[(f32, f32)], gate: f32, inl: &mut [(f32, f32)]) -> Option<(f32, f32)> {
+    let n = ts.len();
+    let mut best = (0usize, 0.0f32, 0.0f32);
+    for i in 0..n {
+        for j in (i + 1)..n {
+            let ds = ts[j].0 - ts[i].0;
+            if ds == 0.0 {
+                continue;
+            }
+            let be = (ts[j].1 - ts[i].1) / ds;
+            if math_abs(be) > gate {
+                continue;
+            }
+            let al = ts[i].1 - be * ts[i].0;
+            let cnt = ts
+                .iter()
+                .filter(|&&(s, t)| math_abs(t - al - be * s) <= gate)
+                .count();
+            if cnt > best.0 {
+                best = (cnt, al, be);
+            }
+        }
+    }
+    if best.0 < 2 {
+        return fit(ts);
+    }
+    let mut k = 0;
+    for &(s, t) in ts {
+        if math_abs(t - best.1 - best.2 * s) <= gate && k < inl.len() {
+            inl[k] = (s, t);
+            k += 1;
+        }
+    }
+    fit(&inl[..k])
+}
+
+/// Total-least-squares line through points: `(theta, c)` with `theta in [0, pi)` the
+/// normal angle, or `None` with fewer than 2 points.
+fn tls(pts: &[(f32, f32)]) -> Option<(f32, f32)> {
+    if pts.len() < 2 {
+        return None;
+    }
+    let n = pts.len() as f32;
+    let (mx, my) = pts
+        .iter()
+        .fold((0.0, 0.0), |(a, b), &(x, y)| (a + x / n, b + y / n));
+    let (mut sxx, mut syy, mut sxy) = (0.0f32, 0.0f32, 0.0f32);
+    for &(x, y) in pts {
+        sxx += (x - mx) * (x - mx);
+        syy += (y - my) * (y - my);
+        sxy += (x - mx) * (y - my);
+    }
+    // principal direction phi, normal theta = phi + pi/2
+    let phi = 0.5 * math::atan2(2.0 * sxy, sxx - syy);
+    let mut th = phi + 0.5 * math::PI;
+    if th >= math::PI {
+        th -= math::PI;
+    }
+    if th < 0.0 {
+        th += math::PI;
+    }
+    if !th.is_finite() {
+        return None;
+    }
+    let c = mx * math::cos(th) + my * math::sin(th);
+    Some((th, c))
+}
+
 /// Track recovery for one peak (eq. 8-9): per scan, the effective plot nearest the line
 /// within `D_max`; if none, the nearest pre-detection plot within `D_max` (look-back).
 ///
-/// Beyond the paper: the line crosses the whole area, so candidates are also gated along
-/// the line. Pass 1 associates effective plots on the line only; a least-squares fit of the
-/// along-line coordinate against the scan index predicts the position per scan; passes 2-3
-/// re-associate with `|t - t_pred| <= along_gate` (pass 3 with the look-back).
+/// Beyond the paper (the peak's cell centre is a coarse line and the line crosses the
+/// whole area): pass 1 associates effective plots to the peak's line (eq. 8-9) and fits
+/// their along-line coordinate against the scan index (constant velocity) by consensus
+/// (clutter plots far along the line are outliers); pass 2 re-associates with
+/// `|t - t_pred| <= along_gate` as well, the line is refined by total least squares
+/// through those plots and the motion refitted; pass 3 associates to the refined line,
+/// with the look-back.
+/// The track's `theta`, `c` are the refined line.
 #[allow(clippy::too_many_arguments)]
 pub fn recover<const R: usize, const A: usize, const P: usize, const NS: usize>(
     geom: &Geometry<R, A>,
@@ -325,13 +401,15 @@ pub fn recover<const R: usize, const A: usize, const P: usize, const NS: usize>(
     track: &mut Track<NS>,
 ) {
     let a = usize::from(peak.a);
-    let (c, s) = geom.trig(a);
+    let (mut c, mut s) = geom.trig(a);
     let (x0, y0) = geom.origin();
-    let cc = x0 * c + y0 * s + geom.rho_center(usize::from(peak.r));
+    let mut cc = x0 * c + y0 * s + geom.rho_center(usize::from(peak.r));
     track.peak = peak;
     track.theta = geom.theta(a);
     track.c = cc;
     let mut ts = [(0.0f32, 0.0f32); NS];
+    let mut xy = [(0.0f32, 0.0f32); NS];
+    let mut inl = [(0.0f32, 0.0f32); NS];
     let mut pred: Option<(f32, f32)> = None;
     for pass in 0..3 {
         let mut nt = 0usize;
@@ -378,16 +456,36 @@ pub fn recover<const R: usize, const A: usize, const P: usize, const NS: usize>(
                 } else {
                     track.n_effective += 1;
                     let p = scan[usize::from(best.1)];
-                    ts[nt] = (si as f32, -p.x * s + p.y * c);
+                    xy[nt] = (p.x, p.y);
+                    ts[nt] = (si as f32, 0.0);
                     nt += 1;
                 }
             }
         }
-        if pass < 2 {
-            match fit(&ts[..nt]) {
-                Some(f) => pred = Some(f),
-                None => break,
+        if pass == 2 {
+            break;
+        }
+        if pass == 1 {
+            // refine the line through the gated plots
+            if let Some((th, c2)) = tls(&xy[..nt]) {
+                track.theta = th;
+                track.c = c2;
+                cc = c2;
+                c = math::cos(th);
+                s = math::sin(th);
             }
+        }
+        for (t, p) in ts[..nt].iter_mut().zip(&xy[..nt]) {
+            t.1 = -p.0 * s + p.1 * c;
+        }
+        let f = if pass == 0 {
+            fit_consensus(&ts[..nt], assoc.along_gate, &mut inl)
+        } else {
+            fit(&ts[..nt])
+        };
+        match f {
+            Some(f) => pred = Some(f),
+            None => break,
         }
     }
 }

@@ -155,7 +155,8 @@ pub struct Detection {
     pub tracks: u16,
     /// Peaks whose track had fewer than `min_track_plots` plots.
     pub short: u16,
-    /// Peaks whose track shared more than half its plots with a stronger track.
+    /// Peaks whose track had more than half its plots already in stronger tracks (a
+    /// second peak of one target, or a line across several targets' tracks).
     pub merged: u16,
 }
 
@@ -411,12 +412,13 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
                 det.short += 1;
                 continue;
             }
-            let dup = self.tracks[..nt].iter().any(|o| {
-                let shared = (0..ns)
-                    .filter(|&s| tr.plots[s] != NO_PLOT && tr.plots[s] == o.plots[s])
-                    .count();
-                2 * shared > usize::from(tr.n_plots)
-            });
+            let claimed = (0..ns)
+                .filter(|&s| {
+                    tr.plots[s] != NO_PLOT
+                        && self.tracks[..nt].iter().any(|o| o.plots[s] == tr.plots[s])
+                })
+                .count();
+            let dup = 2 * claimed > usize::from(tr.n_plots);
             if dup {
                 det.merged += 1;
                 continue;
