@@ -20,14 +20,11 @@
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use anyhow::Context as _;
 use faint_core::detect::hough::{
     ClassicConfig, ClassicHough, Geometry, MhtConfig, MhtTbd, NO_PLOT,
 };
-use faint_core::rng::Rng;
-use rayon::prelude::*;
 
 use crate::analysis::hough_model::{self, CellModel, ModelParams};
 use crate::scenario::sea_clutter::{Origin, SeaClutter, Trial};
@@ -306,51 +303,10 @@ pub fn model_params(sc: &SeaClutter) -> ModelParams {
     }
 }
 
-/// Run `trials` trials in parallel (trial `i` uses `Rng::from_stream(seed, i)`), with a
-/// progress line on stderr.
-pub fn run_trials<T: Send>(
-    seed: u64,
-    trials: usize,
-    label: &str,
-    f: impl Fn(usize, &mut Rng) -> T + Sync,
-) -> Vec<T> {
-    let done = AtomicUsize::new(0);
-    let step = (trials / 20).max(1);
-    (0..trials)
-        .into_par_iter()
-        .map(|i| {
-            let mut rng = Rng::from_stream(seed, i as u64);
-            let r = f(i, &mut rng);
-            let d = done.fetch_add(1, Ordering::Relaxed) + 1;
-            if d % step == 0 || d == trials {
-                eprint!("\r{label}: {d}/{trials}   ");
-                if d == trials {
-                    eprintln!();
-                }
-            }
-            r
-        })
-        .collect()
-}
-
-/// Clopper-Pearson 95 % interval of `k / n`.
+/// Clopper-Pearson 95 % interval of `k / n`: `(p, lo, hi)`.
 pub fn proportion_ci(k: u64, n: u64) -> (f64, f64, f64) {
-    use statrs::distribution::{Beta, ContinuousCDF};
-    if n == 0 {
-        return (f64::NAN, 0.0, 1.0);
-    }
-    let p = k as f64 / n as f64;
-    let lo = if k == 0 {
-        0.0
-    } else {
-        Beta::new(k as f64, (n - k + 1) as f64).map_or(0.0, |b| b.inverse_cdf(0.025))
-    };
-    let hi = if k == n {
-        1.0
-    } else {
-        Beta::new((k + 1) as f64, (n - k) as f64).map_or(1.0, |b| b.inverse_cdf(0.975))
-    };
-    (p, lo, hi)
+    let p = crate::stats::detection::proportion(k as usize, n as usize);
+    (p.p, p.lo, p.hi)
 }
 
 fn write_csv<S: serde::Serialize>(path: &Path, rows: &[S]) -> anyhow::Result<()> {
@@ -613,17 +569,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let g1u = g1.clamp(1, 255) as u8;
         let gcu = gc.clamp(1, 255) as u8;
         let seed = faint_core::rng::derive_seed(args.seed, li as u64);
-        let res: Vec<TrialStats> =
-            run_trials(seed, trials, &format!("mht lambda={lambda}"), |_, rng| {
+        let res: Vec<TrialStats> = crate::montecarlo::run_trials(
+            seed,
+            trials,
+            &format!("mht lambda={lambda}"),
+            |_, rng| {
                 let Ok((mut m, mut c)) = detectors(&sc, g1u, gcu) else {
                     return TrialStats::default();
                 };
                 let tr = sc.generate(rng);
                 evaluate_trial(&sc, &tr, &mut m, &mut c)
-            });
+            },
+        );
         let mut null_sc = sc;
         null_sc.n_targets = 0;
-        let nres: Vec<TrialStats> = run_trials(
+        let nres: Vec<TrialStats> = crate::montecarlo::run_trials(
             seed ^ 0x6e75_6c6c,
             null_trials,
             &format!("null lambda={lambda}"),

@@ -22,7 +22,7 @@ pub enum Origin {
 }
 
 /// The preset's parameters.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct SeaClutter {
     /// `[x_min, x_max, y_min, y_max]` (m).
     pub area: [f32; 4],
