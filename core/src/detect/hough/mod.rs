@@ -86,6 +86,11 @@ pub struct MhtConfig {
     pub lookback: bool,
     /// Tracks with fewer associated plots are not confirmed.
     pub min_track_plots: u16,
+    /// A track is confirmed only if its effective plots that follow one constant-velocity
+    /// motion along the line (the along-gated association) number at least
+    /// `confirm_frac * gamma_1`: the paper's "correct the detections with the association
+    /// results"; it rejects peaks built from pieces of unrelated chains and tracks.
+    pub confirm_frac: f32,
     /// Smallest DMHT rho half-range (m) (degenerate geometry).
     pub drho_min: f32,
 }
@@ -106,6 +111,7 @@ impl MhtConfig {
             along_gate: 100.0,
             lookback: true,
             min_track_plots: 3,
+            confirm_frac: 0.75,
             drho_min: 50.0,
         }
     }
@@ -131,6 +137,9 @@ impl MhtConfig {
         if !(self.along_gate.is_finite() && self.along_gate > 0.0) {
             return Err(Error::InvalidConfig("along_gate"));
         }
+        if !(self.confirm_frac.is_finite() && (0.0..=1.0).contains(&self.confirm_frac)) {
+            return Err(Error::InvalidConfig("confirm_frac"));
+        }
         if !(self.drho_min.is_finite() && self.drho_min > 0.0) {
             return Err(Error::InvalidConfig("drho_min"));
         }
@@ -153,7 +162,8 @@ pub struct Detection {
     pub condense: CondenseStats,
     /// Confirmed tracks (see [`MhtTbd::tracks`]).
     pub tracks: u16,
-    /// Peaks whose track had fewer than `min_track_plots` plots.
+    /// Peaks whose track had fewer than `min_track_plots` plots or fewer than
+    /// `confirm_frac * gamma_1` effective plots.
     pub short: u16,
     /// Peaks whose track had more than half its plots already in stronger tracks (a
     /// second peak of one target, or a line across several targets' tracks).
@@ -408,7 +418,8 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
                 &assoc,
                 &mut tr,
             );
-            if tr.n_plots < self.cfg.min_track_plots {
+            let need = self.cfg.confirm_frac * f32::from(self.cfg.gamma1);
+            if tr.n_plots < self.cfg.min_track_plots || f32::from(tr.n_effective) < need {
                 det.short += 1;
                 continue;
             }
