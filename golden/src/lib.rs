@@ -309,3 +309,44 @@ fn existence_cases(emit: &mut dyn FnMut(&str, &[u32])) {
         ],
     );
 }
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use std::string::String;
+    use std::vec::Vec;
+
+    use super::*;
+
+    #[test]
+    fn line_format() {
+        let mut s = String::new();
+        write_line(&mut s, "a.b", &[0, 0xDEAD_BEEF]).unwrap();
+        assert_eq!(s, "golden a.b 00000000 deadbeef");
+    }
+
+    #[test]
+    fn case_names_unique_and_non_empty() {
+        let mut names: Vec<String> = Vec::new();
+        cases(&mut |name, words| {
+            assert!(!words.is_empty(), "{name} emitted no words");
+            assert!(!name.contains(' '), "{name}");
+            names.push(name.into());
+        });
+        let n = names.len();
+        names.sort();
+        names.dedup();
+        assert_eq!(names.len(), n, "duplicate golden case names");
+    }
+
+    #[test]
+    fn deterministic() {
+        let mut a = Vec::new();
+        let mut b = Vec::new();
+        cases(&mut |_, w| a.extend_from_slice(w));
+        cases(&mut |_, w| b.extend_from_slice(w));
+        assert_eq!(a, b);
+        // No case failed on the host.
+        assert!(!a.contains(&ERR));
+    }
+}
