@@ -12,8 +12,8 @@
 //!
 //! minus the count of an empty measurement. The result is an **executed-instruction
 //! count**, not Cortex-M4 cycles: loads, taken branches, divisions and FPU divides take
-//! more than one cycle on silicon (budget roughly 1.2-2 cycles per instruction on an M4F
-//! running from zero-wait-state memory, more with flash wait states). It is exact and
+//! more than one cycle on silicon and flash wait states add more, so cycles exceed this
+//! count by a factor that only a board measurement gives (not measured here). It is exact and
 //! deterministic: two runs print the same numbers. [`calibrate`] checks the conversion
 //! against a hand-written loop of known length at start-up.
 //!
