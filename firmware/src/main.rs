@@ -14,6 +14,7 @@ use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
 
 mod harness;
+mod mht;
 mod primitives;
 
 #[entry]
@@ -26,6 +27,7 @@ fn main() -> ! {
     harness::table_header();
     primitives::run();
     // Detectors: one `<name>::run();` line each, here.
+    mht::run();
     hprintln!();
     hprintln!(
         "static RAM of this image (.data + .bss, all rows): {} bytes",

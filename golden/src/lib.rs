@@ -37,6 +37,8 @@ use faint_core::math;
 use faint_core::particles::{self, Scheme};
 use faint_core::rng::Rng;
 
+mod mht;
+
 /// Master seed of every golden case.
 pub const SEED: u64 = 0x00FA_1A7F_601D_E115;
 
@@ -95,6 +97,7 @@ pub fn cases(emit: &mut dyn FnMut(&str, &[u32])) {
     weight_cases(emit);
     resample_cases(emit);
     existence_cases(emit);
+    mht::cases(emit);
 }
 
 fn bits<const K: usize>(mut f: impl FnMut() -> f32) -> [u32; K] {

@@ -261,6 +261,27 @@ pub struct Track<const NS: usize> {
     pub n_effective: u16,
 }
 
+impl<const NS: usize> Track<NS> {
+    /// An empty track.
+    pub const fn empty() -> Self {
+        Self {
+            peak: Peak {
+                r: 0,
+                a: 0,
+                value16: 0,
+                raw: 0,
+                cells: 0,
+            },
+            theta: 0.0,
+            c: 0.0,
+            plots: [NO_PLOT; NS],
+            lookback: 0,
+            n_plots: 0,
+            n_effective: 0,
+        }
+    }
+}
+
 impl<const NS: usize> Default for Track<NS> {
     fn default() -> Self {
         Self {

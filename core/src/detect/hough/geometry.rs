@@ -41,6 +41,25 @@ pub struct Geometry<const R: usize, const A: usize> {
 }
 
 impl<const R: usize, const A: usize> Geometry<R, A> {
+    /// An all-zero placeholder (for `static` detector storage); replace it with
+    /// [`Geometry::new`] before use.
+    pub const fn placeholder() -> Self {
+        Self {
+            cos: [0.0; A],
+            sin: [0.0; A],
+            cos_q: [0; A],
+            sin_q: [0; A],
+            x0: 0.0,
+            y0: 0.0,
+            rho_max: 1.0,
+            drho: 1.0,
+            inv_drho: 1.0,
+            scale: 1.0,
+            rmax_q: 1,
+            mul_q: 0,
+        }
+    }
+
     /// A grid with origin `(x0, y0)` covering `rho in [-rho_max, rho_max]`.
     ///
     /// `rho_max` is floored at `1e-3` m (degenerate geometry: all points at the origin

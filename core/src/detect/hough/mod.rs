@@ -213,24 +213,52 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     /// A detector for a configuration (validated here). The struct is large
     /// (`~ NS P 13 + R A 4` bytes): box it on the host, make it `static` on a target.
     pub fn new(cfg: MhtConfig) -> Result<Self> {
-        cfg.validate(NS)?;
-        if P > usize::from(u16::MAX) || P == 0 || T == 0 {
-            return Err(Error::InvalidConfig("capacity"));
-        }
-        Ok(Self {
-            cfg,
-            msht: Geometry::for_area(cfg.area),
-            dmht: Geometry::for_area(cfg.area),
-            plots: [[Plot::default(); P]; NS],
+        let mut d = Self::unconfigured();
+        d.configure(cfg)?;
+        Ok(d)
+    }
+
+    /// A zeroed detector for `static` storage (compile-time constant, lands in `.bss`
+    /// on a target). [`MhtTbd::configure`] must succeed before `step`; until then `step`
+    /// returns `Error::InvalidConfig("unconfigured")`.
+    pub const fn unconfigured() -> Self {
+        const EMPTY: Plot = Plot::new(0.0, 0.0, 0.0);
+        Self {
+            cfg: MhtConfig::sea_clutter(),
+            msht: Geometry::placeholder(),
+            dmht: Geometry::placeholder(),
+            plots: [[EMPTY; P]; NS],
             counts: [0; NS],
             flags: [[0; P]; NS],
             censor: Censor::new(),
             acc: Accumulator::new(),
-            peaks: [Peak::default(); T],
-            tracks: [Track::default(); T],
+            peaks: [Peak {
+                r: 0,
+                a: 0,
+                value16: 0,
+                raw: 0,
+                cells: 0,
+            }; T],
+            tracks: [Track::empty(); T],
             ntracks: 0,
-            scan: 0,
-        })
+            scan: usize::MAX,
+        }
+    }
+
+    /// Validate `cfg`, build the geometry, and start a new period (in place: no large
+    /// copy, usable on a `static`).
+    pub fn configure(&mut self, cfg: MhtConfig) -> Result<()> {
+        cfg.validate(NS)?;
+        if P > usize::from(u16::MAX) || P == 0 || T == 0 {
+            return Err(Error::InvalidConfig("capacity"));
+        }
+        self.cfg = cfg;
+        self.msht = Geometry::for_area(cfg.area);
+        self.dmht = self.msht;
+        self.counts = [0; NS];
+        self.ntracks = 0;
+        self.scan = 0;
+        Ok(())
     }
 
     /// The configuration.
@@ -294,6 +322,9 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     /// Feed one scan of plots. See the module doc for the handling of bad plots.
     pub fn step(&mut self, scan_plots: &[Plot]) -> Result<MhtReport> {
         let s = self.scan;
+        if s >= NS {
+            return Err(Error::InvalidConfig("unconfigured"));
+        }
         if s == 0 {
             self.counts = [0; NS];
             self.ntracks = 0;

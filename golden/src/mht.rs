@@ -1,0 +1,101 @@
+//! MHT-TBD (paper 003): censoring flags, DMHT geometry and recovered tracks of a small
+//! scene (1.5 km square, 10 scans, 40 clutter plots per scan, 2 targets), and the classic
+//! detector's peaks on the same scans. Stack use ~14 KiB (the detector lives on the stack).
+
+use crate::{Fold, ERR, SEED};
+use faint_core::detect::hough::{ClassicConfig, ClassicHough, MhtConfig, MhtTbd};
+use faint_core::model::plot::Plot;
+use faint_core::rng::Rng;
+
+type Det = MhtTbd<48, 10, 32, 30, 4>;
+
+fn scan(rng: &mut Rng, s: usize, out: &mut [Plot; 48]) -> usize {
+    let mut n = 0;
+    for _ in 0..40 {
+        out[n] = Plot::new(
+            1.0,
+            rng.uniform_range(0.0, 1500.0),
+            rng.uniform_range(0.0, 1500.0),
+        );
+        n += 1;
+    }
+    let t = s as f32;
+    out[n] = Plot::new(5.0, 200.0 + 60.0 * t + 4.0 * rng.normal(), 300.0 + 40.0 * t);
+    out[n + 1] = Plot::new(
+        5.0,
+        1200.0 - 30.0 * t,
+        200.0 + 70.0 * t + 4.0 * rng.normal(),
+    );
+    n + 2
+}
+
+pub(crate) fn cases(emit: &mut dyn FnMut(&str, &[u32])) {
+    let mut cfg = MhtConfig::sea_clutter();
+    cfg.area = [0.0, 1500.0, 0.0, 1500.0];
+    cfg.n_scans = 10;
+    cfg.gamma1 = 6;
+    let mut det = Det::unconfigured();
+    let ccfg = ClassicConfig {
+        area: cfg.area,
+        n_scans: 10,
+        gamma: 8,
+    };
+    let (Ok(()), Ok(mut classic)) = (det.configure(cfg), ClassicHough::<32, 30, 4>::new(ccfg))
+    else {
+        emit("mht.detection", &[ERR]);
+        return;
+    };
+    let mut rng = Rng::from_stream(SEED, 3);
+    let mut buf = [Plot::default(); 48];
+    let mut detection = None;
+    for s in 0..10 {
+        let n = scan(&mut rng, s, &mut buf);
+        match (det.step(&buf[..n]), classic.step(&buf[..n])) {
+            (Ok(r), Ok(_)) => detection = r.detection.or(detection),
+            _ => {
+                emit("mht.detection", &[ERR]);
+                return;
+            }
+        }
+    }
+    let mut flags = Fold::new();
+    for s in 0..10 {
+        for k in 0..det.scan_plots(s).len() {
+            flags.push(u32::from(det.is_effective(s, k)));
+        }
+    }
+    emit("mht.effective_flags", &[flags.value()]);
+    match detection {
+        Some(d) => emit(
+            "mht.detection",
+            &[
+                d.effective_plots,
+                d.origin.0.to_bits(),
+                d.origin.1.to_bits(),
+                d.drho.to_bits(),
+                u32::from(d.condense.peaks),
+                u32::from(d.tracks),
+            ],
+        ),
+        None => emit("mht.detection", &[ERR]),
+    }
+    let mut tracks = Fold::new();
+    for tr in det.tracks() {
+        tracks.push(tr.theta.to_bits());
+        tracks.push(tr.c.to_bits());
+        tracks.push(u32::from(tr.peak.r) << 16 | u32::from(tr.peak.a));
+        for &k in &tr.plots {
+            tracks.push(u32::from(k));
+        }
+    }
+    emit("mht.tracks", &[tracks.value()]);
+    let mut peaks = Fold::new();
+    for p in classic.peaks() {
+        peaks.push(u32::from(p.r) << 16 | u32::from(p.a));
+        peaks.push(u32::from(p.raw));
+    }
+    emit(
+        "mht.classic_peaks",
+        &[classic.peaks().len() as u32, peaks.value()],
+    );
+}
