@@ -27,6 +27,15 @@ enum Command {
         /// Preset name, as listed by `faint scenarios`.
         name: String,
     },
+    /// Reproduce a paper's figures and tables (CSV, SVG plots, Markdown table).
+    #[command(subcommand)]
+    Reproduce(Reproduce),
+}
+
+#[derive(Subcommand, Debug)]
+enum Reproduce {
+    /// MHT-TBD (modified Hough transform) in dense sea clutter, with the classic Hough TBD.
+    Mht(faint::host::reproduce::mht::Args),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -43,6 +52,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!("{}", serde_json::to_string_pretty(&v)?);
             Ok(())
         }
+        Command::Reproduce(r) => match r {
+            Reproduce::Mht(a) => faint::host::reproduce::mht::run(&a),
+        },
     }
 }
 

@@ -36,3 +36,37 @@ fn help_lists_commands() {
     assert_eq!(code, 0);
     assert!(out.contains("scenarios"));
 }
+
+#[test]
+fn out_of_range_arguments_are_clear_errors() {
+    for (args, needle) in [
+        (
+            &["reproduce", "mht", "--quick", "--pfa", "3"][..],
+            "--pfa must lie in (0, 1)",
+        ),
+        (
+            &["reproduce", "mht", "--quick", "--lambda", "-5"][..],
+            "--lambda must lie in",
+        ),
+        (
+            &["reproduce", "mht", "--trials", "x"][..],
+            "invalid value 'x'",
+        ),
+    ] {
+        let (code, _, err) = faint(args);
+        assert_ne!(code, 0, "{args:?}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+#[test]
+fn known_scenarios_print_as_json() {
+    let (code, out, _) = faint(&["scenarios"]);
+    assert_eq!(code, 0);
+    for name in out.lines().filter_map(|l| l.split_whitespace().next()) {
+        let (c, json, err) = faint(&["scenario", name]);
+        assert_eq!(c, 0, "{name}: {err}");
+        assert!(json.trim_start().starts_with('{'), "{name}: {json}");
+    }
+}

@@ -554,6 +554,22 @@ struct Summary {
 
 /// Entry point.
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        args.pfa > 0.0 && args.pfa < 1.0,
+        "--pfa must lie in (0, 1), got {}",
+        args.pfa
+    );
+    anyhow::ensure!(args.trials > 0, "--trials must be at least 1");
+    anyhow::ensure!(!args.lambda.is_empty(), "give at least one --lambda");
+    for &l in &args.lambda {
+        anyhow::ensure!(
+            l.is_finite() && l > 0.0 && l <= 2000.0,
+            "--lambda must lie in (0, 2000] clutter plots per scan, got {l}"
+        );
+    }
+    if let Some(g) = args.gamma1 {
+        anyhow::ensure!(g >= 1, "--gamma1 must be at least 1");
+    }
     let (trials, null_trials) = if args.quick {
         (20, 20)
     } else {
@@ -569,6 +585,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let g1 = args.gamma1.map_or(g1, usize::from);
         let g1u = g1.clamp(1, 255) as u8;
         let gcu = gc.clamp(1, 255) as u8;
+        // Surface a configuration error once, before the trials (which cannot report it).
+        detectors(&sc, g1u, gcu).map_err(|e| anyhow::anyhow!("lambda {lambda}: {e}"))?;
         let seed = faint_core::rng::derive_seed(args.seed, li as u64);
         let res: Vec<TrialStats> = crate::montecarlo::run_trials(
             seed,

@@ -8,7 +8,11 @@ pub mod sea_clutter;
 /// `(name, one-line description, preset as JSON)` of every built-in scenario.
 type Entry = (&'static str, &'static str, fn() -> serde_json::Value);
 
-const CATALOGUE: &[Entry] = &[];
+const CATALOGUE: &[Entry] = &[(
+    "sea-clutter",
+    "MHT-TBD (Bao et al. 2022): 6 km x 6 km sea surface, 5 CV targets, Poisson clutter (shown at lambda = 398)",
+    || serde_json::to_value(sea_clutter::SeaClutter::paper(398.0)).unwrap_or_default(),
+)];
 
 /// Names and descriptions of the built-in scenarios.
 pub fn catalogue() -> impl Iterator<Item = (&'static str, &'static str)> {
