@@ -45,7 +45,7 @@ fn out_of_range_arguments_are_clear_errors() {
             "--pfa must lie in (0, 1)",
         ),
         (
-            &["reproduce", "mht", "--quick", "--lambda", "-5"][..],
+            &["reproduce", "mht", "--quick", "--lambda", "0"][..],
             "--lambda must lie in",
         ),
         (
