@@ -30,11 +30,14 @@
 #[cfg(test)]
 extern crate std;
 
+pub mod detect;
 pub mod error;
 pub mod existence;
 pub mod math;
+pub mod model;
 pub mod particles;
 pub mod rng;
+pub mod statistic;
 
 pub use error::Error;
 pub use num_complex::Complex32;

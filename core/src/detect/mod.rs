@@ -1,0 +1,5 @@
+//! Detectors, one module per paper's algorithm.
+pub mod bernoulli;
+pub mod crpf;
+pub mod pf_lrt;
+pub mod pf_tbd;

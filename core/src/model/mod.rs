@@ -1,0 +1,2 @@
+//! Observation and motion models shared by detectors.
+pub mod doppler;
