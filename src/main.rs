@@ -27,6 +27,15 @@ enum Command {
         /// Preset name, as listed by `faint scenarios`.
         name: String,
     },
+    /// Reproduce a paper's figures and tables.
+    #[command(subcommand)]
+    Reproduce(Reproduce),
+}
+
+#[derive(Subcommand, Debug)]
+enum Reproduce {
+    /// CRPF-TBD vs PF-TBD, JOTT, PF-LRT on the OTHR scenario (Lu et al. 2017).
+    Crpf(faint::host::reproduce::crpf::Args),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -43,6 +52,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!("{}", serde_json::to_string_pretty(&v)?);
             Ok(())
         }
+        Command::Reproduce(Reproduce::Crpf(a)) => faint::host::reproduce::crpf::run(&a),
     }
 }
 

@@ -44,9 +44,7 @@
 
 use crate::existence::Transition;
 use crate::math;
-use crate::model::doppler::{
-    check_frame, FrameDetector, Model, ModelConfig, TbdReport, MAX_BINS,
-};
+use crate::model::doppler::{check_frame, FrameDetector, Model, ModelConfig, TbdReport, MAX_BINS};
 use crate::particles::{gather_in_place, resample, Scheme};
 use crate::rng::Rng;
 use crate::{Complex32, Error, Result};
@@ -118,7 +116,11 @@ impl CrpfConfig {
         if !(0.0..=1.0).contains(&self.r_th) {
             return Err(Error::InvalidConfig("correlation threshold r_th"));
         }
-        if self.jitter_std.iter().any(|s| !(s.is_finite() && *s >= 0.0)) {
+        if self
+            .jitter_std
+            .iter()
+            .any(|s| !(s.is_finite() && *s >= 0.0))
+        {
             return Err(Error::InvalidConfig("jitter std"));
         }
         self.model.build()
@@ -383,7 +385,11 @@ impl<const N: usize> CrpfTbd<N> {
                 // Gate (eq. 10); the parent's zh, hh are 0 if it had E = 0.
                 let num = (pr.zh + par.zh).norm();
                 let den2 = norm_m2 * (pr.hh + par.hh);
-                let r = if den2 > 0.0 { num / math::sqrt(den2) } else { 0.0 };
+                let r = if den2 > 0.0 {
+                    num / math::sqrt(den2)
+                } else {
+                    0.0
+                };
                 if r >= r_th {
                     next = Particle {
                         x,

@@ -49,7 +49,9 @@ pub(crate) fn check_variance(v: f32) -> Result<f32> {
     if v.is_finite() && v > 0.0 && (1.0 / v).is_finite() {
         Ok(1.0 / v)
     } else {
-        Err(Error::InvalidConfig("noise variance must be finite and > 0"))
+        Err(Error::InvalidConfig(
+            "noise variance must be finite and > 0",
+        ))
     }
 }
 

@@ -3,10 +3,16 @@
 
 use anyhow::{bail, Result};
 
+pub mod othr;
+
 /// `(name, one-line description, preset as JSON)` of every built-in scenario.
 type Entry = (&'static str, &'static str, fn() -> serde_json::Value);
 
-const CATALOGUE: &[Entry] = &[];
+const CATALOGUE: &[Entry] = &[(
+    "othr",
+    "sky-wave OTHR, one range cell, Doppler-manoeuvring target, K = m = 32 (Lu et al. 2017)",
+    othr::describe,
+)];
 
 /// Names and descriptions of the built-in scenarios.
 pub fn catalogue() -> impl Iterator<Item = (&'static str, &'static str)> {
