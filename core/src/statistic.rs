@@ -25,13 +25,12 @@ pub fn zeta_k(values: &[f32]) -> Result<f32> {
 
 /// The zero-based sorted indices `D_K` averages: the middle 4 for even `K >= 4`
 /// (`K/2 - 2 ..= K/2 + 1`, i.e. 14..=17 for `K = 32`), the middle 3 for odd `K >= 3`
-/// (`(K-1)/2 - 1 ..= (K-1)/2 + 1`), all values for `K <= 2`.
-pub fn middle_range(k: usize) -> core::ops::RangeInclusive<usize> {
+/// (`(K-1)/2 - 1 ..= (K-1)/2 + 1`), all values for `K <= 2` (empty for `K = 0`).
+pub fn middle_range(k: usize) -> core::ops::Range<usize> {
     match k {
-        0 => 1..=0,
-        1 | 2 => 0..=k - 1,
-        _ if k % 2 == 0 => k / 2 - 2..=k / 2 + 1,
-        _ => (k - 1) / 2 - 1..=(k - 1) / 2 + 1,
+        0..=2 => 0..k,
+        _ if k % 2 == 0 => k / 2 - 2..k / 2 + 2,
+        _ => (k - 1) / 2 - 1..(k - 1) / 2 + 2,
     }
 }
 
@@ -51,7 +50,7 @@ pub fn d_k(values: &[f32]) -> Result<f32> {
     s.copy_from_slice(values);
     s.sort_unstable_by(|a, b| a.total_cmp(b));
     let r = middle_range(values.len());
-    let n = (r.end() - r.start() + 1) as f32;
+    let n = r.len() as f32;
     let mut acc = 0.0f32;
     for i in r {
         acc += s[i];
@@ -65,9 +64,9 @@ mod tests {
 
     #[test]
     fn middle_of_32_is_14_to_17() {
-        assert_eq!(middle_range(32), 14..=17);
-        assert_eq!(middle_range(5), 1..=3);
-        assert_eq!(middle_range(2), 0..=1);
+        assert_eq!(middle_range(32), 14..18);
+        assert_eq!(middle_range(5), 1..4);
+        assert_eq!(middle_range(2), 0..2);
         let v: [f32; 32] = core::array::from_fn(|i| (31 - i) as f32);
         assert_eq!(d_k(&v).unwrap(), (14.0 + 15.0 + 16.0 + 17.0) / 4.0);
         assert_eq!(zeta_k(&v).unwrap(), 31.0);

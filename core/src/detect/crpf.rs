@@ -196,8 +196,7 @@ impl<const N: usize> CrpfTbd<N> {
         let e = cfg.q * cfg.p * 0.5;
         let int_exponent = if cfg.lambda == 0.0
             && cfg.weighting == Weighting::Power
-            && e >= 1.0
-            && e <= 32.0
+            && (1.0..=32.0).contains(&e)
             && math::round(e) == e
         {
             Some(e as u32)
