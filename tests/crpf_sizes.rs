@@ -13,7 +13,7 @@ fn check(name: &str, n: usize, size: usize, per: usize) {
     let fixed = size as isize - (per * n) as isize;
     println!("{name:9} N = {n:5}: {size:7} B ({per} B/particle + {fixed} B)");
     assert!(
-        fixed >= 0 && fixed < 6 * 1024,
+        (0..6 * 1024).contains(&fixed),
         "{name} {n}: fixed part {fixed}"
     );
 }
