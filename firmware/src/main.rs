@@ -13,6 +13,7 @@
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
 
+mod crpf;
 mod harness;
 mod primitives;
 
@@ -26,6 +27,7 @@ fn main() -> ! {
     harness::table_header();
     primitives::run();
     // Detectors: one `<name>::run();` line each, here.
+    crpf::run();
     hprintln!();
     hprintln!(
         "static RAM of this image (.data + .bss, all rows): {} bytes",
