@@ -355,6 +355,7 @@ impl<const N: usize> CrpfTbd<N> {
         let r_th = self.cfg.r_th;
         let js = self.cfg.jitter_std;
         let mut count = 0usize;
+        let absent_log_c = self.log_cost(zz_floor, f32::NEG_INFINITY, ln_lambda);
         for i in 0..N {
             let par = self.parts[i];
             let t = self.model.chain.sample(par.e, &mut self.rng);
@@ -378,7 +379,7 @@ impl<const N: usize> CrpfTbd<N> {
                 zh: Complex32::new(0.0, 0.0),
                 hh: 0.0,
             };
-            let mut d2 = zz_floor;
+            let mut d2 = None;
             if let Some(x) = cand {
                 let pr = self.model.obs.project(z, x[0], x[2]);
                 // Gate (eq. 10); the parent's zh, hh are 0 if it had E = 0.
@@ -397,11 +398,16 @@ impl<const N: usize> CrpfTbd<N> {
                         zh: pr.zh,
                         hh: pr.hh,
                     };
-                    d2 = pr.residual_norm2(zz);
+                    d2 = Some(pr.residual_norm2(zz));
                     count += 1;
                 }
             }
-            next.log_c = self.log_cost(d2, par.log_c, ln_lambda);
+            next.log_c = match d2 {
+                Some(d2) => self.log_cost(d2, par.log_c, ln_lambda),
+                // E = 0: ||z||^p, the same for every absent particle when lambda = 0.
+                None if self.cfg.lambda == 0.0 => absent_log_c,
+                None => self.log_cost(zz_floor, par.log_c, ln_lambda),
+            };
             self.parts[i] = next;
         }
 
