@@ -34,6 +34,8 @@ enum Command {
 
 #[derive(Subcommand, Debug)]
 enum Reproduce {
+    /// CRPF-TBD vs PF-TBD, JOTT, PF-LRT on the OTHR scenario (Lu et al. 2017).
+    Crpf(faint::host::reproduce::crpf::Args),
     /// MHT-TBD (modified Hough transform) in dense sea clutter, with the classic Hough TBD.
     Mht(faint::host::reproduce::mht::Args),
 }
@@ -53,6 +55,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Reproduce(r) => match r {
+            Reproduce::Crpf(a) => faint::host::reproduce::crpf::run(&a),
             Reproduce::Mht(a) => faint::host::reproduce::mht::run(&a),
         },
     }

@@ -37,6 +37,7 @@ pub mod math;
 pub mod model;
 pub mod particles;
 pub mod rng;
+pub mod statistic;
 
 pub use error::Error;
 pub use num_complex::Complex32;

@@ -13,6 +13,7 @@
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
 
+mod crpf;
 mod harness;
 mod mht;
 mod primitives;
@@ -28,6 +29,7 @@ fn main() -> ! {
     primitives::run();
     // Detectors: one `<name>::run();` line each, here.
     mht::run();
+    crpf::run();
     hprintln!();
     hprintln!(
         "static RAM of this image (.data + .bss, all rows): {} bytes",

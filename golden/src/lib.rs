@@ -32,6 +32,8 @@
 
 use core::fmt;
 
+pub mod crpf;
+
 use faint_core::existence::ExistenceMarkov;
 use faint_core::math;
 use faint_core::particles::{self, Scheme};
@@ -98,6 +100,7 @@ pub fn cases(emit: &mut dyn FnMut(&str, &[u32])) {
     resample_cases(emit);
     existence_cases(emit);
     mht::cases(emit);
+    crpf::cases(emit);
 }
 
 fn bits<const K: usize>(mut f: impl FnMut() -> f32) -> [u32; K] {

@@ -1,2 +1,6 @@
-//! Detectors, one module per family.
+//! Detectors, one module per paper's algorithm.
+pub mod bernoulli;
+pub mod crpf;
 pub mod hough;
+pub mod pf_lrt;
+pub mod pf_tbd;

@@ -1,2 +1,3 @@
-//! Observation models: the per-frame inputs detectors consume.
+//! Observation and motion models: the per-frame inputs detectors consume.
+pub mod doppler;
 pub mod plot;

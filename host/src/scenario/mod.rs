@@ -3,12 +3,17 @@
 
 use anyhow::{bail, Result};
 
+pub mod othr;
 pub mod sea_clutter;
 
 /// `(name, one-line description, preset as JSON)` of every built-in scenario.
 type Entry = (&'static str, &'static str, fn() -> serde_json::Value);
 
 const CATALOGUE: &[Entry] = &[(
+    "othr",
+    "sky-wave OTHR, one range cell, Doppler-manoeuvring target, K = m = 32 (Lu et al. 2017)",
+    othr::describe,
+), (
     "sea-clutter",
     "MHT-TBD (Bao et al. 2022): 6 km x 6 km sea surface, 5 CV targets, Poisson clutter (shown at lambda = 398)",
     || serde_json::to_value(sea_clutter::SeaClutter::paper(398.0)).unwrap_or_default(),

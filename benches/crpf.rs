@@ -1,0 +1,54 @@
+//! Per-frame cost of CRPF-TBD and its comparators on the OTHR scenario (5 dB, Gaussian).
+//!
+//! One iteration = `reset` + a whole 32-frame run; throughput is reported per frame
+//! (`elements` = frames). Paper (MATLAB, PC): CRPF-TBD 2.51 s per 32-frame run at
+//! N = 6000 (78 ms per frame). Goal: CRPF-TBD N = 6000 under 0.5 ms per frame.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use faint::core::detect::bernoulli::BernoulliTbd;
+use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint::core::detect::pf_lrt::PfLrt;
+use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint::core::model::doppler::{estimate_noise_variance, FrameDetector};
+use faint::core::rng::Rng;
+use faint::host::scenario::othr::{Noise, Othr};
+use std::hint::black_box;
+
+fn run_all(d: &mut dyn FrameDetector, frames: &[Vec<faint::core::Complex32>]) -> f32 {
+    d.reset(7);
+    let mut acc = 0.0;
+    for z in frames {
+        acc += d.step(black_box(z)).map(|r| r.existence).unwrap_or(0.0);
+    }
+    acc
+}
+
+fn bench_n<const N: usize>(c: &mut Criterion) {
+    let run = Othr::default().simulate(Some(5.0), Noise::Gaussian, &mut Rng::seed_from_u64(1));
+    let var = estimate_noise_variance(run.frames.iter().map(|f| f.as_slice()), 32).unwrap();
+    let g = GaussConfig::othr(var);
+    let mut dets: Vec<(&str, Box<dyn FrameDetector>)> = vec![
+        (
+            "crpf_tbd",
+            Box::new(CrpfTbd::<N>::new(CrpfConfig::othr(), 1).unwrap()),
+        ),
+        ("pf_tbd", Box::new(PfTbd::<N>::new(g, 1).unwrap())),
+        ("jott", Box::new(BernoulliTbd::<N>::new(g, 1).unwrap())),
+        ("pf_lrt", Box::new(PfLrt::<N>::new(g, 1).unwrap())),
+    ];
+    let mut group = c.benchmark_group(format!("othr_frame_n{N}"));
+    group.throughput(Throughput::Elements(run.frames.len() as u64));
+    group.sample_size(20);
+    for (name, d) in dets.iter_mut() {
+        group.bench_function(*name, |b| b.iter(|| run_all(d.as_mut(), &run.frames)));
+    }
+    group.finish();
+}
+
+fn benches(c: &mut Criterion) {
+    bench_n::<1000>(c);
+    bench_n::<6000>(c);
+}
+
+criterion_group!(crpf, benches);
+criterion_main!(crpf);

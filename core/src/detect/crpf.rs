@@ -1,0 +1,484 @@
+//! CRPF-TBD: the cost-reference particle filter with an existence variable
+//! (Lu, Wang, Zhang, Acta Electronica Sinica 45(6), 2017, §2.1-§2.2).
+//!
+//! Each particle carries `(x, E, C)`. No noise statistics are used anywhere: particles
+//! are weighted by a monotone function of a cost.
+//!
+//! ```text
+//! costs (eq. 11):   E = 1: C = lambda Cbar + ||z_k - h_k(x)||^p,  E = 0: C = lambda Cbar + ||z_k||^p
+//! risks:            the same expression on the predicted particle
+//! weights (eq. 4):  mu(R_i) = R_i^-q / sum_j R_j^-q
+//!         (eq. 5):  mu(R_i) ∝ (R_i - min_j R_j + gamma)^-q
+//! existence (eq. 9): Pb = P(E_k=1|E_{k-1}=0), Pd = P(E_k=0|E_{k-1}=1)
+//! gate (eq. 10):    r = |<m_k, m_k^i>| / (||m_k|| ||m_k^i||),  m_k = [z_k, z_{k-1}],
+//!                   m_k^i = [h_k(x_k^i), h_{k-1}(x_{k-1}^parent)];  r < r_th => E = 0, x = 0
+//! existence (eq. 12): P_E^k = (1/N) sum_i E_k^i
+//! estimates (eq. 8): mean-cost sum_i x_i mu(C_i), min-cost x_argmin C  (over E = 1)
+//! ```
+//!
+//! Steps per frame `k`: (2) predict every particle's existence by `Pi`, continuing ->
+//! `F x`, born -> `U(I_x0)`, absent -> 0, and compute its risk; (3) resample the frame
+//! `k-1` particles with `mu(R)` (systematic), keeping each copy's parent values; (4) draw
+//! the existence again by `Pi`, jitter continuing particles `x ~ N(F xbar, Sigma)`, draw
+//! births from `U(I_x0)`, apply the gate; (5) `P_E^k`.
+//!
+//! Implementation notes:
+//! - All weights are computed in the log domain: `ln mu_i = -q ln R_i` (eq. 4) with
+//!   `ln R_i = (p/2) ln ||.||^2` (or `logaddexp(ln lambda + ln Cbar, ...)`), then the
+//!   maximum is subtracted before `exp`, so nothing overflows `f32` even with `p = 8`.
+//!   When `lambda = 0`, eq. 4 is used and `q p / 2` is a whole number, the same
+//!   normalised weights are computed without `ln`/`exp` as `(min ||.||^2 / ||.||^2)^(q p/2)`
+//!   (the log-domain normalisation in closed form: the best particle gets weight 1).
+//! - `Sigma = diag(jitter_std^2)` (empirical, [`CrpfConfig::jitter_std`]).
+//! - The parent's `<z_{k-1}, h_{k-1}>` and `||h_{k-1}||^2` needed by the gate were
+//!   computed for its own cost one frame earlier; each particle stores them, so the gate
+//!   costs no extra projection. A particle with `E = 0` has `x = 0`, hence `h = 0`. Before
+//!   the first frame `z_0 = 0`.
+//! - All-zero frame (documented recovery): squared norms are floored at
+//!   `f32::MIN_POSITIVE`, so costs stay finite; the gate sees `||m_k|| = 0` only if both
+//!   frames are zero, and then rejects (`r = 0`).
+//! - `P(E_0 = 1)` is [`ModelConfig::initial_existence`](crate::model::doppler::ModelConfig).
+//!
+//! Memory: `N * 32` bytes of particles plus `N * 12` bytes of weights and ancestors
+//! (about 264 KB at `N = 6000`): build large instances in a `Box` or a `static`.
+
+use crate::existence::Transition;
+use crate::math;
+use crate::model::doppler::{check_frame, FrameDetector, Model, ModelConfig, TbdReport, MAX_BINS};
+use crate::particles::{gather_in_place, resample, Scheme};
+use crate::rng::Rng;
+use crate::{Complex32, Error, Result};
+
+/// Resampling weight function `phi(R)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Weighting {
+    /// `phi(R) = R^-q` (eq. 4, the paper's choice).
+    Power,
+    /// `phi(R) = (R - min R + gamma)^-q`, `0 < gamma < 1` (eq. 5).
+    Shifted {
+        /// `gamma`.
+        gamma: f32,
+    },
+}
+
+/// Runtime values of CRPF-TBD.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CrpfConfig {
+    /// The shared OTHR model (observation, motion, existence chain, birth box). CRPF-TBD
+    /// uses its motion `F` but not its process-noise levels.
+    pub model: ModelConfig,
+    /// Cost exponent `p` (paper: 8).
+    pub p: f32,
+    /// Weight exponent `q` (paper: "a positive integer", value not given; default 1).
+    pub q: f32,
+    /// Forgetting factor `lambda in [0, 1]` (paper: 0).
+    pub lambda: f32,
+    /// Weight function (paper: eq. 4).
+    pub weighting: Weighting,
+    /// Correlation gate threshold `r_th` (paper: 0.2).
+    pub r_th: f32,
+    /// Jitter standard deviations of `Sigma = diag(std^2)` for `[fd, fda, A]`
+    /// (empirical; default `[0.1 Hz, 0.1 Hz/s, 0.02]`).
+    pub jitter_std: [f32; 3],
+}
+
+impl CrpfConfig {
+    /// The paper's values on the OTHR preset: `p = 8`, `q = 1`, `lambda = 0`, eq. 4,
+    /// `r_th = 0.2`.
+    pub fn othr() -> Self {
+        Self {
+            model: ModelConfig::othr(),
+            p: 8.0,
+            q: 1.0,
+            lambda: 0.0,
+            weighting: Weighting::Power,
+            r_th: 0.2,
+            jitter_std: [0.1, 0.1, 0.02],
+        }
+    }
+
+    /// Checks every value; builds the model.
+    pub fn validate(&self) -> Result<Model> {
+        if !(self.p.is_finite() && self.p > 0.0) {
+            return Err(Error::InvalidConfig("cost exponent p"));
+        }
+        if !(self.q.is_finite() && self.q > 0.0) {
+            return Err(Error::InvalidConfig("weight exponent q"));
+        }
+        if !(0.0..=1.0).contains(&self.lambda) {
+            return Err(Error::InvalidConfig("forgetting factor lambda"));
+        }
+        if let Weighting::Shifted { gamma } = self.weighting {
+            if !(gamma > 0.0 && gamma < 1.0) {
+                return Err(Error::InvalidConfig("gamma of eq. 5"));
+            }
+        }
+        if !(0.0..=1.0).contains(&self.r_th) {
+            return Err(Error::InvalidConfig("correlation threshold r_th"));
+        }
+        if self
+            .jitter_std
+            .iter()
+            .any(|s| !(s.is_finite() && *s >= 0.0))
+        {
+            return Err(Error::InvalidConfig("jitter std"));
+        }
+        self.model.build()
+    }
+}
+
+/// One CRPF-TBD particle.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Particle {
+    x: [f32; 3],
+    e: bool,
+    /// `ln C` (`-inf` for `C = 0`).
+    log_c: f32,
+    /// `<z, h(x)>` at the particle's own frame (0 if `E = 0`).
+    zh: Complex32,
+    /// `||h(x)||^2` at the particle's own frame (0 if `E = 0`).
+    hh: f32,
+}
+
+/// `ln(e^a + e^b)`, exact for `-inf` arguments.
+#[inline]
+fn log_add_exp(a: f32, b: f32) -> f32 {
+    let (hi, lo) = if a > b { (a, b) } else { (b, a) };
+    if lo == f32::NEG_INFINITY {
+        return hi;
+    }
+    hi + math::ln1p(math::exp(lo - hi))
+}
+
+/// `x^n` for a small whole `n >= 1` by repeated squaring.
+#[inline]
+fn powi(x: f32, mut n: u32) -> f32 {
+    let mut acc = 1.0f32;
+    let mut b = x;
+    while n > 0 {
+        if n & 1 == 1 {
+            acc *= b;
+        }
+        b *= b;
+        n >>= 1;
+    }
+    acc
+}
+
+/// CRPF-TBD with `N` particles.
+#[derive(Debug, Clone)]
+pub struct CrpfTbd<const N: usize> {
+    cfg: CrpfConfig,
+    model: Model,
+    parts: [Particle; N],
+    /// Log risks, then log weights; reused as scratch.
+    log_w: [f32; N],
+    w: [f32; N],
+    anc: [u32; N],
+    prev: [Complex32; MAX_BINS],
+    prev_zz: f32,
+    rng: Rng,
+    frame: u32,
+    /// `q p / 2` when the ln-free weight path applies.
+    int_exponent: Option<u32>,
+}
+
+impl<const N: usize> CrpfTbd<N> {
+    /// Validates `cfg` and initialises the particles (step 1) from `seed`.
+    pub fn new(cfg: CrpfConfig, seed: u64) -> Result<Self> {
+        if N == 0 {
+            return Err(Error::InvalidConfig("particle count N = 0"));
+        }
+        if u32::try_from(N).is_err() {
+            return Err(Error::IndexOutOfRange);
+        }
+        let model = cfg.validate()?;
+        let e = cfg.q * cfg.p * 0.5;
+        let int_exponent = if cfg.lambda == 0.0
+            && cfg.weighting == Weighting::Power
+            && (1.0..=32.0).contains(&e)
+            && math::round(e) == e
+        {
+            Some(e as u32)
+        } else {
+            None
+        };
+        let mut s = Self {
+            cfg,
+            model,
+            parts: [Particle::default(); N],
+            log_w: [0.0; N],
+            w: [0.0; N],
+            anc: [0; N],
+            prev: [Complex32::new(0.0, 0.0); MAX_BINS],
+            prev_zz: 0.0,
+            rng: Rng::seed_from_u64(seed),
+            frame: 0,
+            int_exponent,
+        };
+        s.reset(seed);
+        Ok(s)
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &CrpfConfig {
+        &self.cfg
+    }
+
+    /// Frames processed since the last reset.
+    pub fn frame(&self) -> u32 {
+        self.frame
+    }
+
+    /// Step 1: `E_0^i ~ Bernoulli(P(E_0 = 1))`, `x ~ U(I_x0)` where `E = 1`, `C = 0`.
+    fn init(&mut self) {
+        let p0 = self.model.initial_existence;
+        for pt in self.parts.iter_mut() {
+            let e = self.rng.bernoulli(p0);
+            *pt = Particle {
+                x: if e {
+                    self.model.prior.sample(&mut self.rng)
+                } else {
+                    [0.0; 3]
+                },
+                e,
+                log_c: f32::NEG_INFINITY,
+                zh: Complex32::new(0.0, 0.0),
+                hh: 0.0,
+            };
+        }
+        self.prev = [Complex32::new(0.0, 0.0); MAX_BINS];
+        self.prev_zz = 0.0;
+        self.frame = 0;
+    }
+
+    /// `ln C` of a squared residual `d2`, with forgetting of the parent cost.
+    #[inline]
+    fn log_cost(&self, d2: f32, parent_log_c: f32, ln_lambda: f32) -> f32 {
+        let c = 0.5 * self.cfg.p * math::ln(d2);
+        if self.cfg.lambda > 0.0 {
+            log_add_exp(ln_lambda + parent_log_c, c)
+        } else {
+            c
+        }
+    }
+
+    /// Steps (2)-(3): risks, weights, resampling. Leaves the resampled parents in
+    /// `self.parts`.
+    fn predict_and_resample(&mut self, z: &[Complex32], zz: f32, ln_lambda: f32) {
+        let zz_floor = zz.max(f32::MIN_POSITIVE);
+        let obs = &self.model.obs;
+        let motion = &self.model.motion;
+        let prior = &self.model.prior;
+        let chain = &self.model.chain;
+        // Squared residual of every predicted particle.
+        for (pt, out) in self.parts.iter().zip(self.log_w.iter_mut()) {
+            let t = chain.sample(pt.e, &mut self.rng);
+            *out = match t {
+                Transition::Continuing => {
+                    let xp = motion.predict(pt.x);
+                    obs.project(z, xp[0], xp[2]).residual_norm2(zz)
+                }
+                Transition::Born => {
+                    let xb = prior.sample(&mut self.rng);
+                    obs.project(z, xb[0], xb[2]).residual_norm2(zz)
+                }
+                _ => zz_floor,
+            };
+        }
+        let ok = if let Some(n) = self.int_exponent {
+            // w_i = (min d2 / d2_i)^(q p / 2): eq. 4 normalised by its largest weight.
+            let mut dmin = f32::INFINITY;
+            for &d in self.log_w.iter() {
+                dmin = dmin.min(d);
+            }
+            for (w, &d) in self.w.iter_mut().zip(self.log_w.iter()) {
+                *w = powi(dmin / d, n);
+            }
+            true
+        } else {
+            // ln R_i, then ln mu_i, all in the log domain.
+            for (i, lr) in self.log_w.iter_mut().enumerate() {
+                let half = 0.5 * self.cfg.p * math::ln(*lr);
+                *lr = if self.cfg.lambda > 0.0 {
+                    log_add_exp(ln_lambda + self.parts[i].log_c, half)
+                } else {
+                    half
+                };
+            }
+            let q = self.cfg.q;
+            match self.cfg.weighting {
+                Weighting::Power => {
+                    for lr in self.log_w.iter_mut() {
+                        *lr *= -q;
+                    }
+                }
+                Weighting::Shifted { gamma } => {
+                    let lmin = self.log_w.iter().fold(f32::INFINITY, |a, &b| a.min(b));
+                    let lg = math::ln(gamma);
+                    for lr in self.log_w.iter_mut() {
+                        // ln(R - Rmin) = ln Rmin + ln(expm1(ln R - ln Rmin))
+                        let d = *lr - lmin;
+                        let l_diff = if d > 30.0 {
+                            lmin + d
+                        } else if d > 0.0 {
+                            lmin + math::ln(math::exp(d) - 1.0)
+                        } else {
+                            f32::NEG_INFINITY
+                        };
+                        *lr = -q * log_add_exp(l_diff, lg);
+                    }
+                }
+            }
+            math::normalize_log_weights(&self.log_w, &mut self.w).is_ok()
+        };
+        // Degenerate weights cannot occur (risks are floored and finite); if they did,
+        // the particles are kept as they are (identity resampling).
+        if ok && resample(Scheme::Systematic, &self.w, &mut self.anc, &mut self.rng).is_ok() {
+            let _ = gather_in_place(&mut self.parts, &self.anc);
+        }
+    }
+
+    fn step_inner(&mut self, z: &[Complex32]) -> Result<TbdReport> {
+        let m = self.model.obs.bins();
+        let zz = check_frame(z, m)?;
+        let ln_lambda = if self.cfg.lambda > 0.0 {
+            math::ln(self.cfg.lambda)
+        } else {
+            f32::NEG_INFINITY
+        };
+        self.predict_and_resample(z, zz, ln_lambda);
+
+        // Step (4): update existence, jitter / births, gate, costs.
+        let zz_floor = zz.max(f32::MIN_POSITIVE);
+        let norm_m2 = zz + self.prev_zz;
+        let r_th = self.cfg.r_th;
+        let js = self.cfg.jitter_std;
+        let mut count = 0usize;
+        let absent_log_c = self.log_cost(zz_floor, f32::NEG_INFINITY, ln_lambda);
+        for i in 0..N {
+            let par = self.parts[i];
+            let t = self.model.chain.sample(par.e, &mut self.rng);
+            let cand = match t {
+                Transition::Continuing => {
+                    let xp = self.model.motion.predict(par.x);
+                    let a = xp[2] + js[2] * self.rng.normal();
+                    Some([
+                        self.model.motion.wrap(xp[0] + js[0] * self.rng.normal()),
+                        xp[1] + js[1] * self.rng.normal(),
+                        if a < 0.0 { -a } else { a },
+                    ])
+                }
+                Transition::Born => Some(self.model.prior.sample(&mut self.rng)),
+                _ => None,
+            };
+            let mut next = Particle {
+                x: [0.0; 3],
+                e: false,
+                log_c: 0.0,
+                zh: Complex32::new(0.0, 0.0),
+                hh: 0.0,
+            };
+            let mut d2 = None;
+            if let Some(x) = cand {
+                let pr = self.model.obs.project(z, x[0], x[2]);
+                // Gate (eq. 10); the parent's zh, hh are 0 if it had E = 0.
+                let num = (pr.zh + par.zh).norm();
+                let den2 = norm_m2 * (pr.hh + par.hh);
+                let r = if den2 > 0.0 {
+                    num / math::sqrt(den2)
+                } else {
+                    0.0
+                };
+                if r >= r_th {
+                    next = Particle {
+                        x,
+                        e: true,
+                        log_c: 0.0,
+                        zh: pr.zh,
+                        hh: pr.hh,
+                    };
+                    d2 = Some(pr.residual_norm2(zz));
+                    count += 1;
+                }
+            }
+            next.log_c = match d2 {
+                Some(d2) => self.log_cost(d2, par.log_c, ln_lambda),
+                // E = 0: ||z||^p, the same for every absent particle when lambda = 0.
+                None if self.cfg.lambda == 0.0 => absent_log_c,
+                None => self.log_cost(zz_floor, par.log_c, ln_lambda),
+            };
+            self.parts[i] = next;
+        }
+
+        let (mean, min) = self.estimates();
+        self.prev[..m].copy_from_slice(z);
+        self.prev_zz = zz;
+        self.frame += 1;
+        Ok(TbdReport {
+            frame: self.frame,
+            existence: count as f32 / N as f32,
+            log_lr: 0.0,
+            estimate: mean,
+            min_cost_estimate: min,
+        })
+    }
+
+    /// Mean-cost and min-cost estimates (eq. 8) over the `E = 1` particles, with
+    /// `mu(C) = C^-q / sum C^-q` computed in the log domain.
+    fn estimates(&self) -> (Option<[f32; 3]>, Option<[f32; 3]>) {
+        let mut best = f32::INFINITY;
+        let mut arg = None;
+        for (i, p) in self.parts.iter().enumerate() {
+            if p.e && p.log_c < best {
+                best = p.log_c;
+                arg = Some(i);
+            }
+        }
+        let Some(a) = arg else {
+            return (None, None);
+        };
+        // max of -q ln C is at the min cost.
+        let q = self.cfg.q;
+        let top = -q * best;
+        let mut s = 0.0f32;
+        let mut acc = [0.0f32; 3];
+        // Doppler is averaged relative to the min-cost particle so the wrap at the band
+        // edge does not split the mean.
+        let ref_fd = self.parts[a].x[0];
+        let width = self.model.motion.band.1 - self.model.motion.band.0;
+        for p in self.parts.iter().filter(|p| p.e) {
+            let w = math::exp(-q * p.log_c - top);
+            let mut dfd = p.x[0] - ref_fd;
+            if dfd > 0.5 * width {
+                dfd -= width;
+            } else if dfd < -0.5 * width {
+                dfd += width;
+            }
+            acc[0] += w * dfd;
+            acc[1] += w * p.x[1];
+            acc[2] += w * p.x[2];
+            s += w;
+        }
+        // s >= 1 (the min-cost particle contributes exp(0)).
+        let mean = [
+            self.model.motion.wrap(ref_fd + acc[0] / s),
+            acc[1] / s,
+            acc[2] / s,
+        ];
+        (Some(mean), Some(self.parts[a].x))
+    }
+}
+
+impl<const N: usize> FrameDetector for CrpfTbd<N> {
+    /// One frame. Errors (state untouched): [`Error::LengthMismatch`] for a frame that is
+    /// not `m` bins, [`Error::NonFinite`] for NaN/inf samples.
+    fn step(&mut self, frame: &[Complex32]) -> Result<TbdReport> {
+        self.step_inner(frame)
+    }
+
+    fn reset(&mut self, seed: u64) {
+        self.rng = Rng::seed_from_u64(seed);
+        self.init();
+    }
+}

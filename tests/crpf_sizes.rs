@@ -1,0 +1,31 @@
+//! Static RAM of each detector configuration (`size_of`), against the per-particle
+//! budget the docs state: CRPF-TBD 44 B/particle (32 B particle + 4 B log weight + 4 B
+//! weight + 4 B ancestor), PF-TBD 28 B (16 + 12), JOTT and PF-LRT 24 B (12 + 12), plus a
+//! fixed part under 6 KB (the 641-entry response table, 5.1 KB, and the previous frame).
+
+use faint::core::detect::bernoulli::BernoulliTbd;
+use faint::core::detect::crpf::CrpfTbd;
+use faint::core::detect::pf_lrt::PfLrt;
+use faint::core::detect::pf_tbd::PfTbd;
+use std::mem::size_of;
+
+fn check(name: &str, n: usize, size: usize, per: usize) {
+    let fixed = size as isize - (per * n) as isize;
+    println!("{name:9} N = {n:5}: {size:7} B ({per} B/particle + {fixed} B)");
+    assert!(
+        (0..6 * 1024).contains(&fixed),
+        "{name} {n}: fixed part {fixed}"
+    );
+}
+
+#[test]
+fn static_ram_per_configuration() {
+    check("CRPF-TBD", 1000, size_of::<CrpfTbd<1000>>(), 44);
+    check("CRPF-TBD", 6000, size_of::<CrpfTbd<6000>>(), 44);
+    check("PF-TBD", 1000, size_of::<PfTbd<1000>>(), 28);
+    check("PF-TBD", 6000, size_of::<PfTbd<6000>>(), 28);
+    check("JOTT", 1000, size_of::<BernoulliTbd<1000>>(), 24);
+    check("JOTT", 6000, size_of::<BernoulliTbd<6000>>(), 24);
+    check("PF-LRT", 1000, size_of::<PfLrt<1000>>(), 24);
+    check("PF-LRT", 6000, size_of::<PfLrt<6000>>(), 24);
+}
