@@ -29,6 +29,11 @@
 //!   When `lambda = 0`, eq. 4 is used and `q p / 2` is a whole number, the same
 //!   normalised weights are computed without `ln`/`exp` as `(min ||.||^2 / ||.||^2)^(q p/2)`
 //!   (the log-domain normalisation in closed form: the best particle gets weight 1).
+//!   On that path each particle keeps its squared residual `d2 = C^(2/p)` instead of
+//!   `ln C`, and the mean-cost estimate uses the same ratios `(d2_min / d2_i)^(q p/2)`,
+//!   so a frame needs no `ln` or `exp` at all.
+//! - The gate compares `|<m_k, m_k^i>|^2 >= r_th^2 ||m_k||^2 ||m_k^i||^2` (no square root;
+//!   the quotient form is kept as a fallback if a product overflows `f32`).
 //! - `Sigma = diag(jitter_std^2)` (empirical, [`CrpfConfig::jitter_std`]).
 //! - The parent's `<z_{k-1}, h_{k-1}>` and `||h_{k-1}||^2` needed by the gate were
 //!   computed for its own cost one frame earlier; each particle stores them, so the gate
@@ -132,7 +137,8 @@ impl CrpfConfig {
 struct Particle {
     x: [f32; 3],
     e: bool,
-    /// `ln C` (`-inf` for `C = 0`).
+    /// `ln C` (`-inf` for `C = 0`); on the ln-free path (`int_exponent`), the squared
+    /// residual `d2 = C^(2/p)` instead (0 before the first frame).
     log_c: f32,
     /// `<z, h(x)>` at the particle's own frame (0 if `E = 0`).
     zh: Complex32,
@@ -353,9 +359,15 @@ impl<const N: usize> CrpfTbd<N> {
         let zz_floor = zz.max(f32::MIN_POSITIVE);
         let norm_m2 = zz + self.prev_zz;
         let r_th = self.cfg.r_th;
+        let r_th2 = r_th * r_th;
         let js = self.cfg.jitter_std;
         let mut count = 0usize;
-        let absent_log_c = self.log_cost(zz_floor, f32::NEG_INFINITY, ln_lambda);
+        let ln_free = self.int_exponent.is_some();
+        let absent_log_c = if ln_free {
+            zz_floor
+        } else {
+            self.log_cost(zz_floor, f32::NEG_INFINITY, ln_lambda)
+        };
         for i in 0..N {
             let par = self.parts[i];
             let t = self.model.chain.sample(par.e, &mut self.rng);
@@ -383,14 +395,17 @@ impl<const N: usize> CrpfTbd<N> {
             if let Some(x) = cand {
                 let pr = self.model.obs.project(z, x[0], x[2]);
                 // Gate (eq. 10); the parent's zh, hh are 0 if it had E = 0.
-                let num = (pr.zh + par.zh).norm();
+                // r >= r_th  <=>  |<m, m^i>|^2 >= r_th^2 ||m||^2 ||m^i||^2 (no sqrt).
+                let num2 = (pr.zh + par.zh).norm_sqr();
                 let den2 = norm_m2 * (pr.hh + par.hh);
-                let r = if den2 > 0.0 {
-                    num / math::sqrt(den2)
+                let pass = if den2.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
+                    r_th <= 0.0 // r = 0
+                } else if num2.is_finite() && den2.is_finite() {
+                    num2 >= r_th2 * den2
                 } else {
-                    0.0
+                    (pr.zh + par.zh).norm() / math::sqrt(den2) >= r_th
                 };
-                if r >= r_th {
+                if pass {
                     next = Particle {
                         x,
                         e: true,
@@ -403,6 +418,7 @@ impl<const N: usize> CrpfTbd<N> {
                 }
             }
             next.log_c = match d2 {
+                Some(d2) if ln_free => d2,
                 Some(d2) => self.log_cost(d2, par.log_c, ln_lambda),
                 // E = 0: ||z||^p, the same for every absent particle when lambda = 0.
                 None if self.cfg.lambda == 0.0 => absent_log_c,
@@ -438,9 +454,11 @@ impl<const N: usize> CrpfTbd<N> {
         let Some(a) = arg else {
             return (None, None);
         };
-        // max of -q ln C is at the min cost.
+        // max of -q ln C is at the min cost (on the ln-free path `log_c` holds d2 and
+        // mu_i = (d2_min / d2_i)^(q p / 2)).
         let q = self.cfg.q;
         let top = -q * best;
+        let n = self.int_exponent;
         let mut s = 0.0f32;
         let mut acc = [0.0f32; 3];
         // Doppler is averaged relative to the min-cost particle so the wrap at the band
@@ -448,7 +466,10 @@ impl<const N: usize> CrpfTbd<N> {
         let ref_fd = self.parts[a].x[0];
         let width = self.model.motion.band.1 - self.model.motion.band.0;
         for p in self.parts.iter().filter(|p| p.e) {
-            let w = math::exp(-q * p.log_c - top);
+            let w = match n {
+                Some(n) => powi(best / p.log_c, n),
+                None => math::exp(-q * p.log_c - top),
+            };
             let mut dfd = p.x[0] - ref_fd;
             if dfd > 0.5 * width {
                 dfd -= width;

@@ -54,6 +54,10 @@ const TABLE_LEN: usize = SPAN * TABLE_STEPS + 1;
 /// One interpolation row: for each of the [`SPAN`] bins, `[a.re, a.im, (b - a).re,
 /// (b - a).im]` with `a`, `b` the two table points around the bin's position.
 type Row = [[f32; 4]; SPAN];
+/// `0.5 - f32::EPSILON / 4`: `trunc(x + copysign(HALF_DOWN, x))` is `roundf(x)`.
+const HALF_DOWN: f32 = 0.5 - 0.25 * f32::EPSILON;
+/// Below this magnitude (2^22) a table position is rounded inline.
+const LARGE: f32 = 4_194_304.0;
 /// Stated bound on `||h_approx - h_exact|| / ||h_exact||` for the Hamming window, `m = 32`
 /// (measured maximum 2.65e-2, dominated by the side-lobe energy left out).
 pub const RESPONSE_ERROR_BOUND: f64 = 3e-2;
@@ -216,7 +220,16 @@ impl DopplerModel {
     fn locate(&self, fd: f32) -> (usize, &Row, f32) {
         let pos = fd * self.ts * self.m as f32;
         let pos = if pos.is_finite() { pos } else { 0.0 };
-        let b = math::round(pos);
+        let (b, bi) = if pos > -LARGE && pos < LARGE {
+            // libm's roundf, trunc(x + copysign(0.5 - eps/4, x)), inlined.
+            let h = if pos < 0.0 { -HALF_DOWN } else { HALF_DOWN };
+            let bi = (pos + h) as i32;
+            (bi as f32, bi)
+        } else {
+            // Out of any band; `i32::MAX` sends `first` to the exact path below.
+            let b = math::round(pos);
+            (b, i32::MAX)
+        };
         let delta = pos - b; // in [-0.5, 0.5]
         let p0 = (delta + 0.5) * TABLE_STEPS as f32;
         let mut i0 = p0 as usize; // p0 >= 0
@@ -226,7 +239,7 @@ impl DopplerModel {
         let frac = p0 - i0 as f32;
         // b - J (mod m) without a 64-bit division in the usual case |b| < m.
         let m = self.m as i32;
-        let mut first = b as i32 - HALF_SPAN as i32;
+        let mut first = bi - HALF_SPAN as i32;
         if first < 0 {
             first += m;
         }
