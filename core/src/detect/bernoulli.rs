@@ -83,7 +83,7 @@ impl<const N: usize> BernoulliTbd<N> {
             } else {
                 m.motion.propagate(*x, &mut self.rng)
             };
-            *lw = m.obs.project(z, x[0], x[2]).log_lr(self.inv_var);
+            *lw = m.obs.project_re(z, x[0], x[2]).log_lr(self.inv_var);
         }
         // ln I_k = LSE(ln LR) - ln N; finite for a finite frame.
         let lse = math::normalize_log_weights(&self.log_w, &mut self.w);

@@ -283,11 +283,11 @@ impl<const N: usize> CrpfTbd<N> {
             *out = match t {
                 Transition::Continuing => {
                     let xp = motion.predict(pt.x);
-                    obs.project(z, xp[0], xp[2]).residual_norm2(zz)
+                    obs.project_re(z, xp[0], xp[2]).residual_norm2(zz)
                 }
                 Transition::Born => {
                     let xb = prior.sample(&mut self.rng);
-                    obs.project(z, xb[0], xb[2]).residual_norm2(zz)
+                    obs.project_re(z, xb[0], xb[2]).residual_norm2(zz)
                 }
                 _ => zz_floor,
             };

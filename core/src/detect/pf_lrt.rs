@@ -78,7 +78,7 @@ impl<const N: usize> PfLrt<N> {
             if !first {
                 *x = m.motion.propagate(*x, &mut self.rng);
             }
-            *lw = m.obs.project(z, x[0], x[2]).log_lr(self.inv_var);
+            *lw = m.obs.project_re(z, x[0], x[2]).log_lr(self.inv_var);
         }
         let inc = match math::normalize_log_weights(&self.log_w, &mut self.w) {
             Ok(l) => l - math::ln(N as f32),

@@ -163,7 +163,7 @@ impl<const N: usize> PfTbd<N> {
                 }
             }
             *lw = if pt.e {
-                m.obs.project(z, pt.x[0], pt.x[2]).log_lr(self.inv_var)
+                m.obs.project_re(z, pt.x[0], pt.x[2]).log_lr(self.inv_var)
             } else {
                 0.0
             };

@@ -270,13 +270,25 @@ impl DopplerModel {
     /// missing bins as zero).
     #[inline]
     pub fn project(&self, z: &[Complex32], fd: f32, amp: f32) -> Projection {
+        self.project_impl::<true>(z, fd, amp)
+    }
+
+    /// [`project`](Self::project) without `Im <z, h>` (returned as 0): all a cost
+    /// `||z - h||^2` or a Gaussian likelihood ratio needs; bit-identical otherwise.
+    #[inline]
+    pub fn project_re(&self, z: &[Complex32], fd: f32, amp: f32) -> Projection {
+        self.project_impl::<false>(z, fd, amp)
+    }
+
+    #[inline(always)]
+    fn project_impl<const IM: bool>(&self, z: &[Complex32], fd: f32, amp: f32) -> Projection {
         let (first, row, frac) = self.locate(fd);
         let (zr, zi, hh) = match z
             .get(first..first + SPAN)
             .and_then(|s| <&[Complex32; SPAN]>::try_from(s).ok())
         {
             // The five bins do not wrap (27 of 32 positions for m = 32).
-            Some(zs) => kernel(row, zs, frac),
+            Some(zs) => kernel::<IM>(row, zs, frac),
             None => {
                 let mut zs = [Complex32::new(0.0, 0.0); SPAN];
                 let mut b = first;
@@ -289,7 +301,7 @@ impl DopplerModel {
                         b = 0;
                     }
                 }
-                kernel(row, &zs, frac)
+                kernel::<IM>(row, &zs, frac)
             }
         };
         Projection {
@@ -302,7 +314,7 @@ impl DopplerModel {
 /// `sum_b conj(z_b) h_b / A` and `sum_b |h_b|^2 / A^2` over one interpolation row:
 /// fixed-size arrays, fully unrolled, no bounds checks.
 #[inline(always)]
-fn kernel(row: &Row, zs: &[Complex32; SPAN], frac: f32) -> (f32, f32, f32) {
+fn kernel<const IM: bool>(row: &Row, zs: &[Complex32; SPAN], frac: f32) -> (f32, f32, f32) {
     let mut zr = 0.0f32;
     let mut zi = 0.0f32;
     let mut hh = 0.0f32;
@@ -311,7 +323,9 @@ fn kernel(row: &Row, zs: &[Complex32; SPAN], frac: f32) -> (f32, f32, f32) {
         let hi = c[1] + c[3] * frac;
         // conj(z) h
         zr += zb.re * hr + zb.im * hi;
-        zi += zb.re * hi - zb.im * hr;
+        if IM {
+            zi += zb.re * hi - zb.im * hr;
+        }
         hh += hr * hr + hi * hi;
     }
     (zr, zi, hh)
