@@ -159,6 +159,16 @@ fn log_add_exp(a: f32, b: f32) -> f32 {
 /// `x^n` for a small whole `n >= 1` by repeated squaring.
 #[inline]
 fn powi(x: f32, mut n: u32) -> f32 {
+    // The usual exponents unrolled (same products, same rounding as the loop).
+    match n {
+        1 => return x,
+        2 => return x * x,
+        4 => {
+            let x2 = x * x;
+            return x2 * x2;
+        }
+        _ => {}
+    }
     let mut acc = 1.0f32;
     let mut b = x;
     while n > 0 {
@@ -277,7 +287,8 @@ impl<const N: usize> CrpfTbd<N> {
         let motion = &self.model.motion;
         let prior = &self.model.prior;
         let chain = &self.model.chain;
-        // Squared residual of every predicted particle.
+        // Squared residual of every predicted particle, and the smallest.
+        let mut dmin = f32::INFINITY;
         for (pt, out) in self.parts.iter().zip(self.log_w.iter_mut()) {
             let t = chain.sample(pt.e, &mut self.rng);
             *out = match t {
@@ -291,13 +302,10 @@ impl<const N: usize> CrpfTbd<N> {
                 }
                 _ => zz_floor,
             };
+            dmin = dmin.min(*out);
         }
         let ok = if let Some(n) = self.int_exponent {
             // w_i = (min d2 / d2_i)^(q p / 2): eq. 4 normalised by its largest weight.
-            let mut dmin = f32::INFINITY;
-            for &d in self.log_w.iter() {
-                dmin = dmin.min(d);
-            }
             for (w, &d) in self.w.iter_mut().zip(self.log_w.iter()) {
                 *w = powi(dmin / d, n);
             }
@@ -361,7 +369,11 @@ impl<const N: usize> CrpfTbd<N> {
         let r_th = self.cfg.r_th;
         let r_th2 = r_th * r_th;
         let js = self.cfg.jitter_std;
+        // `anc` (free after resampling) collects the indices of the E = 1 particles, so
+        // the estimates visit only those; the min-cost one is tracked here.
         let mut count = 0usize;
+        let mut best = f32::INFINITY;
+        let mut arg = None;
         let ln_free = self.int_exponent.is_some();
         let absent_log_c = if ln_free {
             zz_floor
@@ -424,10 +436,19 @@ impl<const N: usize> CrpfTbd<N> {
                 None if self.cfg.lambda == 0.0 => absent_log_c,
                 None => self.log_cost(zz_floor, par.log_c, ln_lambda),
             };
+            if next.e {
+                if let Some(slot) = self.anc.get_mut(count - 1) {
+                    *slot = i as u32;
+                }
+                if next.log_c < best {
+                    best = next.log_c;
+                    arg = Some(i);
+                }
+            }
             self.parts[i] = next;
         }
 
-        let (mean, min) = self.estimates();
+        let (mean, min) = self.estimates(count, best, arg);
         self.prev[..m].copy_from_slice(z);
         self.prev_zz = zz;
         self.frame += 1;
@@ -442,16 +463,16 @@ impl<const N: usize> CrpfTbd<N> {
 
     /// Mean-cost and min-cost estimates (eq. 8) over the `E = 1` particles, with
     /// `mu(C) = C^-q / sum C^-q` computed in the log domain.
-    fn estimates(&self) -> (Option<[f32; 3]>, Option<[f32; 3]>) {
-        let mut best = f32::INFINITY;
-        let mut arg = None;
-        for (i, p) in self.parts.iter().enumerate() {
-            if p.e && p.log_c < best {
-                best = p.log_c;
-                arg = Some(i);
-            }
-        }
-        let Some(a) = arg else {
+    ///
+    /// `self.anc[..count]` holds the indices of the `E = 1` particles, `best` / `arg` the
+    /// smallest `log_c` among them and its index (both found by the update loop).
+    fn estimates(
+        &self,
+        count: usize,
+        best: f32,
+        arg: Option<usize>,
+    ) -> (Option<[f32; 3]>, Option<[f32; 3]>) {
+        let (Some(a), Some(live)) = (arg, self.anc.get(..count)) else {
             return (None, None);
         };
         // max of -q ln C is at the min cost (on the ln-free path `log_c` holds d2 and
@@ -465,7 +486,7 @@ impl<const N: usize> CrpfTbd<N> {
         // edge does not split the mean.
         let ref_fd = self.parts[a].x[0];
         let width = self.model.motion.band.1 - self.model.motion.band.0;
-        for p in self.parts.iter().filter(|p| p.e) {
+        for p in live.iter().filter_map(|&i| self.parts.get(i as usize)) {
             let w = match n {
                 Some(n) => powi(best / p.log_c, n),
                 None => math::exp(-q * p.log_c - top),
