@@ -302,7 +302,10 @@ impl<const N: usize> CrpfTbd<N> {
                 }
                 _ => zz_floor,
             };
-            dmin = dmin.min(*out);
+            // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never NaN.
+            if *out < dmin {
+                dmin = *out;
+            }
         }
         let ok = if let Some(n) = self.int_exponent {
             // w_i = (min d2 / d2_i)^(q p / 2): eq. 4 normalised by its largest weight.
