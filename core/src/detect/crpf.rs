@@ -50,7 +50,7 @@
 use crate::existence::Transition;
 use crate::math;
 use crate::model::doppler::{check_frame, FrameDetector, Model, ModelConfig, TbdReport, MAX_BINS};
-use crate::particles::{gather_in_place, resample, Scheme};
+use crate::particles::{resample, Scheme};
 use crate::rng::Rng;
 use crate::{Complex32, Error, Result};
 
@@ -144,6 +144,39 @@ struct Particle {
     zh: Complex32,
     /// `||h(x)||^2` at the particle's own frame (0 if `E = 0`).
     hh: f32,
+}
+
+/// `parts[j] = old parts[anc[j]]` in place for sorted ancestors (what
+/// [`resample`] produces), like [`gather_in_place`](crate::particles::gather_in_place) but copying field by field: a
+/// whole-struct copy inside one slice compiles to a `memmove` call per particle on the
+/// M4. Same two passes (ascending for `a > j`, descending for `a < j`).
+fn gather_particles(parts: &mut [Particle], anc: &[u32]) {
+    #[inline(always)]
+    fn copy(parts: &mut [Particle], j: usize, a: usize) {
+        if let Some(&s) = parts.get(a) {
+            let (x, e, log_c, zh, hh) = (s.x, s.e, s.log_c, s.zh, s.hh);
+            if let Some(d) = parts.get_mut(j) {
+                d.x[0] = x[0];
+                d.x[1] = x[1];
+                d.x[2] = x[2];
+                d.e = e;
+                d.log_c = log_c;
+                d.zh.re = zh.re;
+                d.zh.im = zh.im;
+                d.hh = hh;
+            }
+        }
+    }
+    for (j, &a) in anc.iter().enumerate() {
+        if a as usize > j {
+            copy(parts, j, a as usize);
+        }
+    }
+    for (j, &a) in anc.iter().enumerate().rev() {
+        if (a as usize) < j {
+            copy(parts, j, a as usize);
+        }
+    }
 }
 
 /// `ln(e^a + e^b)`, exact for `-inf` arguments.
@@ -352,7 +385,7 @@ impl<const N: usize> CrpfTbd<N> {
         // Degenerate weights cannot occur (risks are floored and finite); if they did,
         // the particles are kept as they are (identity resampling).
         if ok && resample(Scheme::Systematic, &self.w, &mut self.anc, &mut self.rng).is_ok() {
-            let _ = gather_in_place(&mut self.parts, &self.anc);
+            gather_particles(&mut self.parts, &self.anc);
         }
     }
 
