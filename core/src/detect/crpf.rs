@@ -322,15 +322,17 @@ impl<const N: usize> CrpfTbd<N> {
         let chain = &self.model.chain;
         // Squared residual of every predicted particle, and the smallest.
         let mut dmin = f32::INFINITY;
+        // A local copy keeps the generator's state in registers across the loop.
+        let mut rng = self.rng.clone();
         for (pt, out) in self.parts.iter().zip(self.log_w.iter_mut()) {
-            let t = chain.sample(pt.e, &mut self.rng);
+            let t = chain.sample(pt.e, &mut rng);
             *out = match t {
                 Transition::Continuing => {
                     let xp = motion.predict(pt.x);
                     obs.project_re(z, xp[0], xp[2]).residual_norm2(zz)
                 }
                 Transition::Born => {
-                    let xb = prior.sample(&mut self.rng);
+                    let xb = prior.sample(&mut rng);
                     obs.project_re(z, xb[0], xb[2]).residual_norm2(zz)
                 }
                 _ => zz_floor,
@@ -340,6 +342,7 @@ impl<const N: usize> CrpfTbd<N> {
                 dmin = *out;
             }
         }
+        self.rng = rng;
         let ok = if let Some(n) = self.int_exponent {
             // w_i = (min d2 / d2_i)^(q p / 2): eq. 4 normalised by its largest weight.
             for (w, &d) in self.w.iter_mut().zip(self.log_w.iter()) {
@@ -411,6 +414,7 @@ impl<const N: usize> CrpfTbd<N> {
         let mut best = f32::INFINITY;
         let mut arg = None;
         let ln_free = self.int_exponent.is_some();
+        let mut rng = self.rng.clone();
         let absent_log_c = if ln_free {
             zz_floor
         } else {
@@ -418,18 +422,18 @@ impl<const N: usize> CrpfTbd<N> {
         };
         for i in 0..N {
             let par = self.parts[i];
-            let t = self.model.chain.sample(par.e, &mut self.rng);
+            let t = self.model.chain.sample(par.e, &mut rng);
             let cand = match t {
                 Transition::Continuing => {
                     let xp = self.model.motion.predict(par.x);
-                    let a = xp[2] + js[2] * self.rng.normal();
+                    let a = xp[2] + js[2] * rng.normal();
                     Some([
-                        self.model.motion.wrap(xp[0] + js[0] * self.rng.normal()),
-                        xp[1] + js[1] * self.rng.normal(),
+                        self.model.motion.wrap(xp[0] + js[0] * rng.normal()),
+                        xp[1] + js[1] * rng.normal(),
                         if a < 0.0 { -a } else { a },
                     ])
                 }
-                Transition::Born => Some(self.model.prior.sample(&mut self.rng)),
+                Transition::Born => Some(self.model.prior.sample(&mut rng)),
                 _ => None,
             };
             let mut next = Particle {
@@ -483,6 +487,7 @@ impl<const N: usize> CrpfTbd<N> {
             }
             self.parts[i] = next;
         }
+        self.rng = rng;
 
         let (mean, min) = self.estimates(count, best, arg);
         self.prev[..m].copy_from_slice(z);
