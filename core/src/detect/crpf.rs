@@ -214,6 +214,21 @@ fn powi(x: f32, mut n: u32) -> f32 {
     acc
 }
 
+/// `q p / 2` when the ln-free weight path applies (`lambda = 0`, eq. 4, whole `q p / 2`
+/// in `1..=32`).
+fn int_exponent(cfg: &CrpfConfig) -> Option<u32> {
+    let e = cfg.q * cfg.p * 0.5;
+    if cfg.lambda == 0.0
+        && cfg.weighting == Weighting::Power
+        && (1.0..=32.0).contains(&e)
+        && math::round(e) == e
+    {
+        Some(e as u32)
+    } else {
+        None
+    }
+}
+
 /// CRPF-TBD with `N` particles.
 #[derive(Debug, Clone)]
 pub struct CrpfTbd<const N: usize> {
@@ -242,16 +257,7 @@ impl<const N: usize> CrpfTbd<N> {
             return Err(Error::IndexOutOfRange);
         }
         let model = cfg.validate()?;
-        let e = cfg.q * cfg.p * 0.5;
-        let int_exponent = if cfg.lambda == 0.0
-            && cfg.weighting == Weighting::Power
-            && (1.0..=32.0).contains(&e)
-            && math::round(e) == e
-        {
-            Some(e as u32)
-        } else {
-            None
-        };
+        let int_exponent = int_exponent(&cfg);
         let mut s = Self {
             cfg,
             model,
@@ -267,6 +273,24 @@ impl<const N: usize> CrpfTbd<N> {
         };
         s.reset(seed);
         Ok(s)
+    }
+
+    /// Re-validates `cfg` and restarts in place from `seed` (as [`new`](Self::new) would),
+    /// without building a detector by value: how one that lives in a `static` (e.g. the
+    /// firmware's zero-initialised ones) is set up. On error `self` is unchanged.
+    pub fn reconfigure(&mut self, cfg: CrpfConfig, seed: u64) -> Result<()> {
+        if N == 0 {
+            return Err(Error::InvalidConfig("particle count N = 0"));
+        }
+        if u32::try_from(N).is_err() {
+            return Err(Error::IndexOutOfRange);
+        }
+        let model = cfg.validate()?;
+        self.int_exponent = int_exponent(&cfg);
+        self.cfg = cfg;
+        self.model = model;
+        self.reset(seed);
+        Ok(())
     }
 
     /// The configuration.
