@@ -45,7 +45,9 @@
 //! - `P(E_0 = 1)` is [`ModelConfig::initial_existence`](crate::model::doppler::ModelConfig).
 //!
 //! Memory: `N * 32` bytes of particles plus `N * 12` bytes of weights and ancestors
-//! (about 264 KB at `N = 6000`): build large instances in a `Box` or a `static`.
+//! and an 11 KB fixed part, mostly the response table (about 275 KB at `N = 6000`): build
+//! large instances in a `Box`, or zeroed in a `static` and set up by
+//! [`CrpfTbd::reconfigure`].
 
 use crate::existence::Transition;
 use crate::math;
