@@ -37,6 +37,22 @@ pub struct BernoulliTbd<const N: usize> {
 }
 
 impl<const N: usize> BernoulliTbd<N> {
+    /// Re-validates `cfg` and restarts in place from `seed` (as [`new`](Self::new) would),
+    /// without building a detector by value: how one that lives in a `static` (e.g. the
+    /// firmware's zero-initialised ones) is set up. On error `self` is unchanged.
+    pub fn reconfigure(&mut self, cfg: GaussConfig, seed: u64) -> Result<()> {
+        if N == 0 {
+            return Err(Error::InvalidConfig("particle count N = 0"));
+        }
+        let model = cfg.validate()?;
+        let inv_var = check_variance(cfg.noise_var)?;
+        self.cfg = cfg;
+        self.model = model;
+        self.inv_var = inv_var;
+        self.reset(seed);
+        Ok(())
+    }
+
     /// Validates `cfg`; `q_0 = initial_existence`, particles from `U(I_x0)`.
     pub fn new(cfg: GaussConfig, seed: u64) -> Result<Self> {
         if N == 0 {
@@ -83,7 +99,7 @@ impl<const N: usize> BernoulliTbd<N> {
             } else {
                 m.motion.propagate(*x, &mut self.rng)
             };
-            *lw = m.obs.project(z, x[0], x[2]).log_lr(self.inv_var);
+            *lw = m.obs.project_re(z, x[0], x[2]).log_lr(self.inv_var);
         }
         // ln I_k = LSE(ln LR) - ln N; finite for a finite frame.
         let lse = math::normalize_log_weights(&self.log_w, &mut self.w);

@@ -29,6 +29,11 @@
 //!   When `lambda = 0`, eq. 4 is used and `q p / 2` is a whole number, the same
 //!   normalised weights are computed without `ln`/`exp` as `(min ||.||^2 / ||.||^2)^(q p/2)`
 //!   (the log-domain normalisation in closed form: the best particle gets weight 1).
+//!   On that path each particle keeps its squared residual `d2 = C^(2/p)` instead of
+//!   `ln C`, and the mean-cost estimate uses the same ratios `(d2_min / d2_i)^(q p/2)`,
+//!   so a frame needs no `ln` or `exp` at all.
+//! - The gate compares `|<m_k, m_k^i>|^2 >= r_th^2 ||m_k||^2 ||m_k^i||^2` (no square root;
+//!   the quotient form is kept as a fallback if a product overflows `f32`).
 //! - `Sigma = diag(jitter_std^2)` (empirical, [`CrpfConfig::jitter_std`]).
 //! - The parent's `<z_{k-1}, h_{k-1}>` and `||h_{k-1}||^2` needed by the gate were
 //!   computed for its own cost one frame earlier; each particle stores them, so the gate
@@ -40,12 +45,14 @@
 //! - `P(E_0 = 1)` is [`ModelConfig::initial_existence`](crate::model::doppler::ModelConfig).
 //!
 //! Memory: `N * 32` bytes of particles plus `N * 12` bytes of weights and ancestors
-//! (about 264 KB at `N = 6000`): build large instances in a `Box` or a `static`.
+//! and an 11 KB fixed part, mostly the response table (about 275 KB at `N = 6000`): build
+//! large instances in a `Box`, or zeroed in a `static` and set up by
+//! [`CrpfTbd::reconfigure`].
 
 use crate::existence::Transition;
 use crate::math;
 use crate::model::doppler::{check_frame, FrameDetector, Model, ModelConfig, TbdReport, MAX_BINS};
-use crate::particles::{gather_in_place, resample, Scheme};
+use crate::particles::{resample, Scheme};
 use crate::rng::Rng;
 use crate::{Complex32, Error, Result};
 
@@ -132,12 +139,46 @@ impl CrpfConfig {
 struct Particle {
     x: [f32; 3],
     e: bool,
-    /// `ln C` (`-inf` for `C = 0`).
+    /// `ln C` (`-inf` for `C = 0`); on the ln-free path (`int_exponent`), the squared
+    /// residual `d2 = C^(2/p)` instead (0 before the first frame).
     log_c: f32,
     /// `<z, h(x)>` at the particle's own frame (0 if `E = 0`).
     zh: Complex32,
     /// `||h(x)||^2` at the particle's own frame (0 if `E = 0`).
     hh: f32,
+}
+
+/// `parts[j] = old parts[anc[j]]` in place for sorted ancestors (what
+/// [`resample`] produces), like [`gather_in_place`](crate::particles::gather_in_place) but copying field by field: a
+/// whole-struct copy inside one slice compiles to a `memmove` call per particle on the
+/// M4. Same two passes (ascending for `a > j`, descending for `a < j`).
+fn gather_particles(parts: &mut [Particle], anc: &[u32]) {
+    #[inline(always)]
+    fn copy(parts: &mut [Particle], j: usize, a: usize) {
+        if let Some(&s) = parts.get(a) {
+            let (x, e, log_c, zh, hh) = (s.x, s.e, s.log_c, s.zh, s.hh);
+            if let Some(d) = parts.get_mut(j) {
+                d.x[0] = x[0];
+                d.x[1] = x[1];
+                d.x[2] = x[2];
+                d.e = e;
+                d.log_c = log_c;
+                d.zh.re = zh.re;
+                d.zh.im = zh.im;
+                d.hh = hh;
+            }
+        }
+    }
+    for (j, &a) in anc.iter().enumerate() {
+        if a as usize > j {
+            copy(parts, j, a as usize);
+        }
+    }
+    for (j, &a) in anc.iter().enumerate().rev() {
+        if (a as usize) < j {
+            copy(parts, j, a as usize);
+        }
+    }
 }
 
 /// `ln(e^a + e^b)`, exact for `-inf` arguments.
@@ -153,6 +194,16 @@ fn log_add_exp(a: f32, b: f32) -> f32 {
 /// `x^n` for a small whole `n >= 1` by repeated squaring.
 #[inline]
 fn powi(x: f32, mut n: u32) -> f32 {
+    // The usual exponents unrolled (same products, same rounding as the loop).
+    match n {
+        1 => return x,
+        2 => return x * x,
+        4 => {
+            let x2 = x * x;
+            return x2 * x2;
+        }
+        _ => {}
+    }
     let mut acc = 1.0f32;
     let mut b = x;
     while n > 0 {
@@ -163,6 +214,21 @@ fn powi(x: f32, mut n: u32) -> f32 {
         n >>= 1;
     }
     acc
+}
+
+/// `q p / 2` when the ln-free weight path applies (`lambda = 0`, eq. 4, whole `q p / 2`
+/// in `1..=32`).
+fn int_exponent(cfg: &CrpfConfig) -> Option<u32> {
+    let e = cfg.q * cfg.p * 0.5;
+    if cfg.lambda == 0.0
+        && cfg.weighting == Weighting::Power
+        && (1.0..=32.0).contains(&e)
+        && math::round(e) == e
+    {
+        Some(e as u32)
+    } else {
+        None
+    }
 }
 
 /// CRPF-TBD with `N` particles.
@@ -193,16 +259,7 @@ impl<const N: usize> CrpfTbd<N> {
             return Err(Error::IndexOutOfRange);
         }
         let model = cfg.validate()?;
-        let e = cfg.q * cfg.p * 0.5;
-        let int_exponent = if cfg.lambda == 0.0
-            && cfg.weighting == Weighting::Power
-            && (1.0..=32.0).contains(&e)
-            && math::round(e) == e
-        {
-            Some(e as u32)
-        } else {
-            None
-        };
+        let int_exponent = int_exponent(&cfg);
         let mut s = Self {
             cfg,
             model,
@@ -218,6 +275,24 @@ impl<const N: usize> CrpfTbd<N> {
         };
         s.reset(seed);
         Ok(s)
+    }
+
+    /// Re-validates `cfg` and restarts in place from `seed` (as [`new`](Self::new) would),
+    /// without building a detector by value: how one that lives in a `static` (e.g. the
+    /// firmware's zero-initialised ones) is set up. On error `self` is unchanged.
+    pub fn reconfigure(&mut self, cfg: CrpfConfig, seed: u64) -> Result<()> {
+        if N == 0 {
+            return Err(Error::InvalidConfig("particle count N = 0"));
+        }
+        if u32::try_from(N).is_err() {
+            return Err(Error::IndexOutOfRange);
+        }
+        let model = cfg.validate()?;
+        self.int_exponent = int_exponent(&cfg);
+        self.cfg = cfg;
+        self.model = model;
+        self.reset(seed);
+        Ok(())
     }
 
     /// The configuration.
@@ -271,27 +346,31 @@ impl<const N: usize> CrpfTbd<N> {
         let motion = &self.model.motion;
         let prior = &self.model.prior;
         let chain = &self.model.chain;
-        // Squared residual of every predicted particle.
+        // Squared residual of every predicted particle, and the smallest.
+        let mut dmin = f32::INFINITY;
+        // A local copy keeps the generator's state in registers across the loop.
+        let mut rng = self.rng.clone();
         for (pt, out) in self.parts.iter().zip(self.log_w.iter_mut()) {
-            let t = chain.sample(pt.e, &mut self.rng);
+            let t = chain.sample(pt.e, &mut rng);
             *out = match t {
                 Transition::Continuing => {
                     let xp = motion.predict(pt.x);
-                    obs.project(z, xp[0], xp[2]).residual_norm2(zz)
+                    obs.project_re(z, xp[0], xp[2]).residual_norm2(zz)
                 }
                 Transition::Born => {
-                    let xb = prior.sample(&mut self.rng);
-                    obs.project(z, xb[0], xb[2]).residual_norm2(zz)
+                    let xb = prior.sample(&mut rng);
+                    obs.project_re(z, xb[0], xb[2]).residual_norm2(zz)
                 }
                 _ => zz_floor,
             };
+            // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never NaN.
+            if *out < dmin {
+                dmin = *out;
+            }
         }
+        self.rng = rng;
         let ok = if let Some(n) = self.int_exponent {
             // w_i = (min d2 / d2_i)^(q p / 2): eq. 4 normalised by its largest weight.
-            let mut dmin = f32::INFINITY;
-            for &d in self.log_w.iter() {
-                dmin = dmin.min(d);
-            }
             for (w, &d) in self.w.iter_mut().zip(self.log_w.iter()) {
                 *w = powi(dmin / d, n);
             }
@@ -335,7 +414,7 @@ impl<const N: usize> CrpfTbd<N> {
         // Degenerate weights cannot occur (risks are floored and finite); if they did,
         // the particles are kept as they are (identity resampling).
         if ok && resample(Scheme::Systematic, &self.w, &mut self.anc, &mut self.rng).is_ok() {
-            let _ = gather_in_place(&mut self.parts, &self.anc);
+            gather_particles(&mut self.parts, &self.anc);
         }
     }
 
@@ -353,23 +432,34 @@ impl<const N: usize> CrpfTbd<N> {
         let zz_floor = zz.max(f32::MIN_POSITIVE);
         let norm_m2 = zz + self.prev_zz;
         let r_th = self.cfg.r_th;
+        let r_th2 = r_th * r_th;
         let js = self.cfg.jitter_std;
+        // `anc` (free after resampling) collects the indices of the E = 1 particles, so
+        // the estimates visit only those; the min-cost one is tracked here.
         let mut count = 0usize;
-        let absent_log_c = self.log_cost(zz_floor, f32::NEG_INFINITY, ln_lambda);
+        let mut best = f32::INFINITY;
+        let mut arg = None;
+        let ln_free = self.int_exponent.is_some();
+        let mut rng = self.rng.clone();
+        let absent_log_c = if ln_free {
+            zz_floor
+        } else {
+            self.log_cost(zz_floor, f32::NEG_INFINITY, ln_lambda)
+        };
         for i in 0..N {
             let par = self.parts[i];
-            let t = self.model.chain.sample(par.e, &mut self.rng);
+            let t = self.model.chain.sample(par.e, &mut rng);
             let cand = match t {
                 Transition::Continuing => {
                     let xp = self.model.motion.predict(par.x);
-                    let a = xp[2] + js[2] * self.rng.normal();
+                    let a = xp[2] + js[2] * rng.normal();
                     Some([
-                        self.model.motion.wrap(xp[0] + js[0] * self.rng.normal()),
-                        xp[1] + js[1] * self.rng.normal(),
+                        self.model.motion.wrap(xp[0] + js[0] * rng.normal()),
+                        xp[1] + js[1] * rng.normal(),
                         if a < 0.0 { -a } else { a },
                     ])
                 }
-                Transition::Born => Some(self.model.prior.sample(&mut self.rng)),
+                Transition::Born => Some(self.model.prior.sample(&mut rng)),
                 _ => None,
             };
             let mut next = Particle {
@@ -383,14 +473,17 @@ impl<const N: usize> CrpfTbd<N> {
             if let Some(x) = cand {
                 let pr = self.model.obs.project(z, x[0], x[2]);
                 // Gate (eq. 10); the parent's zh, hh are 0 if it had E = 0.
-                let num = (pr.zh + par.zh).norm();
+                // r >= r_th  <=>  |<m, m^i>|^2 >= r_th^2 ||m||^2 ||m^i||^2 (no sqrt).
+                let num2 = (pr.zh + par.zh).norm_sqr();
                 let den2 = norm_m2 * (pr.hh + par.hh);
-                let r = if den2 > 0.0 {
-                    num / math::sqrt(den2)
+                let pass = if den2.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
+                    r_th <= 0.0 // r = 0
+                } else if num2.is_finite() && den2.is_finite() {
+                    num2 >= r_th2 * den2
                 } else {
-                    0.0
+                    (pr.zh + par.zh).norm() / math::sqrt(den2) >= r_th
                 };
-                if r >= r_th {
+                if pass {
                     next = Particle {
                         x,
                         e: true,
@@ -403,15 +496,26 @@ impl<const N: usize> CrpfTbd<N> {
                 }
             }
             next.log_c = match d2 {
+                Some(d2) if ln_free => d2,
                 Some(d2) => self.log_cost(d2, par.log_c, ln_lambda),
                 // E = 0: ||z||^p, the same for every absent particle when lambda = 0.
                 None if self.cfg.lambda == 0.0 => absent_log_c,
                 None => self.log_cost(zz_floor, par.log_c, ln_lambda),
             };
+            if next.e {
+                if let Some(slot) = self.anc.get_mut(count - 1) {
+                    *slot = i as u32;
+                }
+                if next.log_c < best {
+                    best = next.log_c;
+                    arg = Some(i);
+                }
+            }
             self.parts[i] = next;
         }
+        self.rng = rng;
 
-        let (mean, min) = self.estimates();
+        let (mean, min) = self.estimates(count, best, arg);
         self.prev[..m].copy_from_slice(z);
         self.prev_zz = zz;
         self.frame += 1;
@@ -426,29 +530,34 @@ impl<const N: usize> CrpfTbd<N> {
 
     /// Mean-cost and min-cost estimates (eq. 8) over the `E = 1` particles, with
     /// `mu(C) = C^-q / sum C^-q` computed in the log domain.
-    fn estimates(&self) -> (Option<[f32; 3]>, Option<[f32; 3]>) {
-        let mut best = f32::INFINITY;
-        let mut arg = None;
-        for (i, p) in self.parts.iter().enumerate() {
-            if p.e && p.log_c < best {
-                best = p.log_c;
-                arg = Some(i);
-            }
-        }
-        let Some(a) = arg else {
+    ///
+    /// `self.anc[..count]` holds the indices of the `E = 1` particles, `best` / `arg` the
+    /// smallest `log_c` among them and its index (both found by the update loop).
+    fn estimates(
+        &self,
+        count: usize,
+        best: f32,
+        arg: Option<usize>,
+    ) -> (Option<[f32; 3]>, Option<[f32; 3]>) {
+        let (Some(a), Some(live)) = (arg, self.anc.get(..count)) else {
             return (None, None);
         };
-        // max of -q ln C is at the min cost.
+        // max of -q ln C is at the min cost (on the ln-free path `log_c` holds d2 and
+        // mu_i = (d2_min / d2_i)^(q p / 2)).
         let q = self.cfg.q;
         let top = -q * best;
+        let n = self.int_exponent;
         let mut s = 0.0f32;
         let mut acc = [0.0f32; 3];
         // Doppler is averaged relative to the min-cost particle so the wrap at the band
         // edge does not split the mean.
         let ref_fd = self.parts[a].x[0];
         let width = self.model.motion.band.1 - self.model.motion.band.0;
-        for p in self.parts.iter().filter(|p| p.e) {
-            let w = math::exp(-q * p.log_c - top);
+        for p in live.iter().filter_map(|&i| self.parts.get(i as usize)) {
+            let w = match n {
+                Some(n) => powi(best / p.log_c, n),
+                None => math::exp(-q * p.log_c - top),
+            };
             let mut dfd = p.x[0] - ref_fd;
             if dfd > 0.5 * width {
                 dfd -= width;

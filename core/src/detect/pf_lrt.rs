@@ -35,6 +35,22 @@ pub struct PfLrt<const N: usize> {
 }
 
 impl<const N: usize> PfLrt<N> {
+    /// Re-validates `cfg` and restarts in place from `seed` (as [`new`](Self::new) would),
+    /// without building a detector by value: how one that lives in a `static` (e.g. the
+    /// firmware's zero-initialised ones) is set up. On error `self` is unchanged.
+    pub fn reconfigure(&mut self, cfg: GaussConfig, seed: u64) -> Result<()> {
+        if N == 0 {
+            return Err(Error::InvalidConfig("particle count N = 0"));
+        }
+        let model = cfg.validate()?;
+        let inv_var = check_variance(cfg.noise_var)?;
+        self.cfg = cfg;
+        self.model = model;
+        self.inv_var = inv_var;
+        self.reset(seed);
+        Ok(())
+    }
+
     /// Validates `cfg`; particles from `U(I_x0)`.
     pub fn new(cfg: GaussConfig, seed: u64) -> Result<Self> {
         if N == 0 {
@@ -78,7 +94,7 @@ impl<const N: usize> PfLrt<N> {
             if !first {
                 *x = m.motion.propagate(*x, &mut self.rng);
             }
-            *lw = m.obs.project(z, x[0], x[2]).log_lr(self.inv_var);
+            *lw = m.obs.project_re(z, x[0], x[2]).log_lr(self.inv_var);
         }
         let inc = match math::normalize_log_weights(&self.log_w, &mut self.w) {
             Ok(l) => l - math::ln(N as f32),

@@ -118,6 +118,22 @@ pub struct PfTbd<const N: usize> {
 }
 
 impl<const N: usize> PfTbd<N> {
+    /// Re-validates `cfg` and restarts in place from `seed` (as [`new`](Self::new) would),
+    /// without building a detector by value: how one that lives in a `static` (e.g. the
+    /// firmware's zero-initialised ones) is set up. On error `self` is unchanged.
+    pub fn reconfigure(&mut self, cfg: GaussConfig, seed: u64) -> Result<()> {
+        if N == 0 {
+            return Err(Error::InvalidConfig("particle count N = 0"));
+        }
+        let model = cfg.validate()?;
+        let inv_var = check_variance(cfg.noise_var)?;
+        self.cfg = cfg;
+        self.model = model;
+        self.inv_var = inv_var;
+        self.reset(seed);
+        Ok(())
+    }
+
     /// Validates `cfg` and draws the initial particles (`E_0 ~ Bernoulli`, `x ~ U(I_x0)`).
     pub fn new(cfg: GaussConfig, seed: u64) -> Result<Self> {
         if N == 0 {
@@ -163,7 +179,7 @@ impl<const N: usize> PfTbd<N> {
                 }
             }
             *lw = if pt.e {
-                m.obs.project(z, pt.x[0], pt.x[2]).log_lr(self.inv_var)
+                m.obs.project_re(z, pt.x[0], pt.x[2]).log_lr(self.inv_var)
             } else {
                 0.0
             };

@@ -51,6 +51,13 @@ pub const SPAN: usize = 2 * HALF_SPAN + 1;
 /// Table points per bin of the window's DTFT.
 pub const TABLE_STEPS: usize = 128;
 const TABLE_LEN: usize = SPAN * TABLE_STEPS + 1;
+/// One interpolation row: for each of the [`SPAN`] bins, `[a.re, a.im, (b - a).re,
+/// (b - a).im]` with `a`, `b` the two table points around the bin's position.
+type Row = [[f32; 4]; SPAN];
+/// `0.5 - f32::EPSILON / 4`: `trunc(x + copysign(HALF_DOWN, x))` is `roundf(x)`.
+const HALF_DOWN: f32 = 0.5 - 0.25 * f32::EPSILON;
+/// Below this magnitude (2^22) a table position is rounded inline.
+const LARGE: f32 = 4_194_304.0;
 /// Stated bound on `||h_approx - h_exact|| / ||h_exact||` for the Hamming window, `m = 32`
 /// (measured maximum 2.65e-2, dominated by the side-lobe energy left out).
 pub const RESPONSE_ERROR_BOUND: f64 = 3e-2;
@@ -119,7 +126,10 @@ pub struct DopplerModel {
     m: usize,
     ts: f32,
     window: Window,
-    table: [Complex32; TABLE_LEN],
+    /// `rows[i0][j]`: the table points `t = i0 + (SPAN - 1 - j) S` and `t + 1` of bin `j`
+    /// (`S` = [`TABLE_STEPS`]), so one fractional table position serves all five bins
+    /// with one bounds check and no index arithmetic in the hot loop.
+    rows: [Row; TABLE_STEPS],
     window_sum: f32,
     window_energy: f32,
 }
@@ -139,6 +149,17 @@ impl DopplerModel {
             let (re, im) = dtft(window, m, u / m as f64);
             *slot = Complex32::new(re as f32, im as f32);
         }
+        let mut rows = [[[0.0f32; 4]; SPAN]; TABLE_STEPS];
+        for (i0, row) in rows.iter_mut().enumerate() {
+            for (j, cell) in row.iter_mut().enumerate() {
+                let t = i0 + (SPAN - 1 - j) * TABLE_STEPS;
+                let (a, b) = match (table.get(t), table.get(t + 1)) {
+                    (Some(&a), Some(&b)) => (a, b),
+                    _ => (Complex32::new(0.0, 0.0), Complex32::new(0.0, 0.0)),
+                };
+                *cell = [a.re, a.im, b.re - a.re, b.im - a.im];
+            }
+        }
         let mut s = 0.0f64;
         let mut s2 = 0.0f64;
         for n in 0..m {
@@ -150,7 +171,7 @@ impl DopplerModel {
             m,
             ts,
             window,
-            table,
+            rows,
             window_sum: s as f32,
             window_energy: s2 as f32,
         })
@@ -194,12 +215,21 @@ impl DopplerModel {
     }
 
     /// Nearest bin `b0` and interpolation position: the first of the [`SPAN`] bins is
-    /// `b0 - J (mod m)`; returns `(first_bin, table index of bin j = -J, fraction)`.
+    /// `b0 - J (mod m)`; returns `(first_bin, interpolation row, fraction)`.
     #[inline]
-    fn locate(&self, fd: f32) -> (usize, usize, f32) {
+    fn locate(&self, fd: f32) -> (usize, &Row, f32) {
         let pos = fd * self.ts * self.m as f32;
         let pos = if pos.is_finite() { pos } else { 0.0 };
-        let b = math::round(pos);
+        let (b, bi) = if pos > -LARGE && pos < LARGE {
+            // libm's roundf, trunc(x + copysign(0.5 - eps/4, x)), inlined.
+            let h = if pos < 0.0 { -HALF_DOWN } else { HALF_DOWN };
+            let bi = (pos + h) as i32;
+            (bi as f32, bi)
+        } else {
+            // Out of any band; `i32::MAX` sends `first` to the exact path below.
+            let b = math::round(pos);
+            (b, i32::MAX)
+        };
         let delta = pos - b; // in [-0.5, 0.5]
         let p0 = (delta + 0.5) * TABLE_STEPS as f32;
         let mut i0 = p0 as usize; // p0 >= 0
@@ -207,60 +237,98 @@ impl DopplerModel {
             i0 = TABLE_STEPS - 1;
         }
         let frac = p0 - i0 as f32;
-        let m = self.m as i64;
-        let first = ((b as i64 - HALF_SPAN as i64) % m + m) % m;
-        (first as usize, i0 + (SPAN - 1) * TABLE_STEPS, frac)
+        // b - J (mod m) without a 64-bit division in the usual case |b| < m.
+        let m = self.m as i32;
+        let mut first = bi - HALF_SPAN as i32;
+        if first < 0 {
+            first += m;
+        }
+        if !(0..m).contains(&first) {
+            first = (b as i64 - HALF_SPAN as i64).rem_euclid(m as i64) as i32;
+        }
+        let row = match self.rows.get(i0) {
+            Some(r) => r,
+            None => &self.rows[0],
+        };
+        (first as usize, row, frac)
     }
 
     /// The evaluated response: `out[j] = h_{first + j (mod m)}` for `j = 0..SPAN`;
     /// returns `first`. Bins outside the span are taken as zero.
     pub fn response(&self, fd: f32, amp: f32, out: &mut [Complex32; SPAN]) -> usize {
-        let (first, top, frac) = self.locate(fd);
-        for (j, o) in out.iter_mut().enumerate() {
-            // Bin first + j is offset jj = j - J from b0; its table index is
-            // p0 + (J - jj) S = top - j S.
-            let t = top - j * TABLE_STEPS;
-            let a = self.table[t];
-            let b = self.table[t + 1];
-            *o = (a + (b - a) * frac) * amp;
+        let (first, row, frac) = self.locate(fd);
+        for (o, c) in out.iter_mut().zip(row.iter()) {
+            let a = Complex32::new(c[0], c[1]);
+            let d = Complex32::new(c[2], c[3]);
+            *o = (a + d * frac) * amp;
         }
         first
     }
 
     /// `<z, h(fd, amp)>` and `||h||^2` over the evaluated bins. `z` must hold `m` bins
-    /// (not checked here: the detectors check each frame once).
+    /// (not checked here: the detectors check each frame once; a shorter `z` reads its
+    /// missing bins as zero).
     #[inline]
     pub fn project(&self, z: &[Complex32], fd: f32, amp: f32) -> Projection {
-        let (first, top, frac) = self.locate(fd);
-        let mut zr = 0.0f32;
-        let mut zi = 0.0f32;
-        let mut hh = 0.0f32;
-        let mut b = first;
-        let mut t = top;
-        for _ in 0..SPAN {
-            let (hr, hi) = match (self.table.get(t), self.table.get(t + 1), z.get(b)) {
-                (Some(&a), Some(&c), Some(&zb)) => {
-                    let hr = a.re + (c.re - a.re) * frac;
-                    let hi = a.im + (c.im - a.im) * frac;
-                    // conj(z) h
-                    zr += zb.re * hr + zb.im * hi;
-                    zi += zb.re * hi - zb.im * hr;
-                    (hr, hi)
+        self.project_impl::<true>(z, fd, amp)
+    }
+
+    /// [`project`](Self::project) without `Im <z, h>` (returned as 0): all a cost
+    /// `||z - h||^2` or a Gaussian likelihood ratio needs; bit-identical otherwise.
+    #[inline]
+    pub fn project_re(&self, z: &[Complex32], fd: f32, amp: f32) -> Projection {
+        self.project_impl::<false>(z, fd, amp)
+    }
+
+    #[inline(always)]
+    fn project_impl<const IM: bool>(&self, z: &[Complex32], fd: f32, amp: f32) -> Projection {
+        let (first, row, frac) = self.locate(fd);
+        let (zr, zi, hh) = match z
+            .get(first..first + SPAN)
+            .and_then(|s| <&[Complex32; SPAN]>::try_from(s).ok())
+        {
+            // The five bins do not wrap (27 of 32 positions for m = 32).
+            Some(zs) => kernel::<IM>(row, zs, frac),
+            None => {
+                let mut zs = [Complex32::new(0.0, 0.0); SPAN];
+                let mut b = first;
+                for o in zs.iter_mut() {
+                    if let Some(&v) = z.get(b) {
+                        *o = v;
+                    }
+                    b += 1;
+                    if b == self.m {
+                        b = 0;
+                    }
                 }
-                _ => (0.0, 0.0),
-            };
-            hh += hr * hr + hi * hi;
-            t = t.wrapping_sub(TABLE_STEPS);
-            b += 1;
-            if b == self.m {
-                b = 0;
+                kernel::<IM>(row, &zs, frac)
             }
-        }
+        };
         Projection {
             zh: Complex32::new(zr * amp, zi * amp),
             hh: hh * amp * amp,
         }
     }
+}
+
+/// `sum_b conj(z_b) h_b / A` and `sum_b |h_b|^2 / A^2` over one interpolation row:
+/// fixed-size arrays, fully unrolled, no bounds checks.
+#[inline(always)]
+fn kernel<const IM: bool>(row: &Row, zs: &[Complex32; SPAN], frac: f32) -> (f32, f32, f32) {
+    let mut zr = 0.0f32;
+    let mut zi = 0.0f32;
+    let mut hh = 0.0f32;
+    for (c, zb) in row.iter().zip(zs.iter()) {
+        let hr = c[0] + c[2] * frac;
+        let hi = c[1] + c[3] * frac;
+        // conj(z) h
+        zr += zb.re * hr + zb.im * hi;
+        if IM {
+            zi += zb.re * hi - zb.im * hr;
+        }
+        hh += hr * hr + hi * hi;
+    }
+    (zr, zi, hh)
 }
 
 /// `W(theta) = sum_n w_n exp(j 2 pi theta n)` in `f64`.

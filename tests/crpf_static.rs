@@ -1,0 +1,98 @@
+//! `reconfigure` restarts a detector in place exactly as `new` builds one, including
+//! from an all-zero value (how the firmware keeps the detectors in `static` memory).
+//!
+//! The all-zero values are `const` items: the compiler's const evaluator checks that
+//! the zero bit pattern is a valid value of every field (enum tags, `Option`, `bool`,
+//! the generator's state), so a type change that made zeroing unsound would fail to
+//! compile here and on the firmware.
+
+use std::mem::MaybeUninit;
+
+use faint::core::detect::bernoulli::BernoulliTbd;
+use faint::core::detect::crpf::{CrpfConfig, CrpfTbd, Weighting};
+use faint::core::detect::pf_lrt::PfLrt;
+use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint::core::model::doppler::{DopplerModel, FrameDetector, TbdReport, Window};
+use faint::core::rng::Rng;
+use faint::core::Complex32;
+
+const N: usize = 64;
+
+// SAFETY: checked by const evaluation (an invalid all-zero field is a compile error).
+const ZERO_CRPF: CrpfTbd<N> = unsafe { MaybeUninit::zeroed().assume_init() };
+const ZERO_PF: PfTbd<N> = unsafe { MaybeUninit::zeroed().assume_init() };
+const ZERO_JOTT: BernoulliTbd<N> = unsafe { MaybeUninit::zeroed().assume_init() };
+const ZERO_LRT: PfLrt<N> = unsafe { MaybeUninit::zeroed().assume_init() };
+
+fn frames() -> Vec<[Complex32; 32]> {
+    let model = DopplerModel::new(32, 0.02, Window::Hamming).unwrap();
+    let mut rng = Rng::seed_from_u64(77);
+    (0..8)
+        .map(|k| {
+            let mut z = [Complex32::new(0.0, 0.0); 32];
+            for c in z.iter_mut() {
+                *c = Complex32::new(2.5 * rng.normal(), 2.5 * rng.normal());
+            }
+            if k >= 2 {
+                let mut h = [Complex32::new(0.0, 0.0); 5];
+                let first = model.response(4.0 + 0.3 * k as f32, 1.2, &mut h);
+                for (j, v) in h.iter().enumerate() {
+                    z[(first + j) % 32] += *v;
+                }
+            }
+            z
+        })
+        .collect()
+}
+
+fn run(d: &mut dyn FrameDetector) -> Vec<TbdReport> {
+    frames().iter().map(|z| d.step(z).unwrap()).collect()
+}
+
+#[test]
+fn reconfigure_equals_new() {
+    let cfg = CrpfConfig::othr();
+    let seed = 2017;
+    let want = run(&mut CrpfTbd::<N>::new(cfg, seed).unwrap());
+    // From zero.
+    let mut z = Box::new(ZERO_CRPF);
+    z.reconfigure(cfg, seed).unwrap();
+    assert_eq!(run(&mut *z), want);
+    // From a detector with another config, mid-run.
+    let other = CrpfConfig {
+        lambda: 0.3,
+        weighting: Weighting::Shifted { gamma: 0.5 },
+        ..cfg
+    };
+    let mut d = CrpfTbd::<N>::new(other, 5).unwrap();
+    let _ = run(&mut d);
+    d.reconfigure(cfg, seed).unwrap();
+    assert_eq!(run(&mut d), want);
+    // A bad config is rejected and leaves the detector as it was.
+    let before = d.clone();
+    let bad = CrpfConfig { p: -1.0, ..cfg };
+    assert!(d.reconfigure(bad, 1).is_err());
+    assert_eq!(d.config(), before.config());
+    assert_eq!(d.frame(), before.frame());
+
+    let g = GaussConfig::othr(12.7);
+    let want = run(&mut PfTbd::<N>::new(g, seed).unwrap());
+    let mut z = Box::new(ZERO_PF);
+    z.reconfigure(g, seed).unwrap();
+    assert_eq!(run(&mut *z), want);
+
+    let want = run(&mut BernoulliTbd::<N>::new(g, seed).unwrap());
+    let mut z = Box::new(ZERO_JOTT);
+    z.reconfigure(g, seed).unwrap();
+    assert_eq!(run(&mut *z), want);
+
+    let want = run(&mut PfLrt::<N>::new(g, seed).unwrap());
+    let mut z = Box::new(ZERO_LRT);
+    z.reconfigure(g, seed).unwrap();
+    assert_eq!(run(&mut *z), want);
+    let bad = GaussConfig {
+        noise_var: 0.0,
+        ..g
+    };
+    assert!(z.reconfigure(bad, 1).is_err());
+}
