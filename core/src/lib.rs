@@ -30,9 +30,11 @@
 #[cfg(test)]
 extern crate std;
 
+pub mod detect;
 pub mod error;
 pub mod existence;
 pub mod math;
+pub mod model;
 pub mod particles;
 pub mod rng;
 

@@ -1,0 +1,2 @@
+//! Detectors.
+pub mod phd;

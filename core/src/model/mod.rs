@@ -1,0 +1,2 @@
+//! Observation models shared by detectors.
+pub mod power_cube;
