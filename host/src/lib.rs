@@ -1,4 +1,17 @@
 //! # faint-host
 //!
-//! The std side of faint: scenario simulators, the Monte Carlo runner, detection
-//! statistics, and CSV/JSON/plot output.
+//! The std side of faint. Data flows one way:
+//! `scenario -> frames -> detector (faint-core) -> report -> statistics`.
+//!
+//! - [`montecarlo`]: parallel trials with per-trial seeds, identical for any thread count.
+//! - [`stats`]: thresholds at a false-alarm rate, detection rates with confidence
+//!   intervals, Pd-versus-SNR crossings, ROC, OSPA.
+//! - [`io`]: CSV, JSON, Markdown tables and SVG plots.
+//! - [`scenario`]: one module per paper's scene (presets are data).
+//! - [`reproduce`]: one module per paper, behind `faint reproduce <name>`.
+
+pub mod io;
+pub mod montecarlo;
+pub mod reproduce;
+pub mod scenario;
+pub mod stats;

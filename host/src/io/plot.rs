@@ -1,0 +1,169 @@
+//! SVG plots with `plotters` (SVG needs no font files, so it works on any machine).
+
+use std::path::Path;
+
+use anyhow::{anyhow, ensure, Result};
+use plotters::prelude::*;
+
+/// One named line of a chart.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    /// Legend label.
+    pub name: String,
+    /// `(x, y)` points, drawn in order.
+    pub points: Vec<(f64, f64)>,
+}
+
+const COLOURS: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
+];
+
+fn range(vals: impl Iterator<Item = f64>) -> Result<(f64, f64)> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in vals.filter(|v| v.is_finite()) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    ensure!(lo <= hi, "nothing finite to plot");
+    if lo == hi {
+        lo -= 0.5;
+        hi += 0.5;
+    }
+    let pad = 0.03 * (hi - lo);
+    Ok((lo - pad, hi + pad))
+}
+
+/// A line chart of several series with markers and a legend, written as SVG.
+pub fn line_chart(
+    path: impl AsRef<Path>,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+) -> Result<()> {
+    let path = path.as_ref();
+    super::ensure_parent(path)?;
+    let (x0, x1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)))?;
+    let (y0, y1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)))?;
+    let root = SVGBackend::new(path, (900, 600)).into_drawing_area();
+    let e = |e: DrawingAreaErrorKind<_>| anyhow!("plotting {}: {e:?}", path.display());
+    root.fill(&WHITE).map_err(e)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 22))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .draw()
+        .map_err(e)?;
+    for (k, s) in series.iter().enumerate() {
+        let col = COLOURS[k % COLOURS.len()];
+        let pts: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .copied()
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+            .collect();
+        chart
+            .draw_series(LineSeries::new(pts.clone(), col.stroke_width(2)))
+            .map_err(e)?
+            .label(s.name.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
+        chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 3, col.filled())))
+            .map_err(e)?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(e)?;
+    root.present().map_err(e)?;
+    Ok(())
+}
+
+/// Overlaid histograms (as step outlines, normalised to densities) of several samples
+/// over a common range, written as SVG.
+pub fn histogram(
+    path: impl AsRef<Path>,
+    title: &str,
+    x_label: &str,
+    samples: &[(String, Vec<f64>)],
+    bins: usize,
+) -> Result<()> {
+    ensure!(bins > 0, "a histogram needs at least one bin");
+    let (lo, hi) = range(samples.iter().flat_map(|s| s.1.iter().copied()))?;
+    let width = (hi - lo) / bins as f64;
+    let series: Vec<Series> = samples
+        .iter()
+        .map(|(name, xs)| {
+            let mut counts = vec![0usize; bins];
+            let mut n = 0usize;
+            for &x in xs.iter().filter(|x| x.is_finite()) {
+                let b = (((x - lo) / width) as usize).min(bins - 1);
+                counts[b] += 1;
+                n += 1;
+            }
+            let mut points = Vec::with_capacity(2 * bins + 2);
+            points.push((lo, 0.0));
+            for (b, &c) in counts.iter().enumerate() {
+                let d = c as f64 / (n.max(1) as f64 * width);
+                points.push((lo + b as f64 * width, d));
+                points.push((lo + (b + 1) as f64 * width, d));
+            }
+            points.push((hi, 0.0));
+            Series {
+                name: name.clone(),
+                points,
+            }
+        })
+        .collect();
+    line_chart(path, title, x_label, "density", &series)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn writes_svg() {
+        let dir = std::env::temp_dir().join(format!("faint-plot-{}", std::process::id()));
+        let p = dir.join("c.svg");
+        line_chart(
+            &p,
+            "Pd vs SNR",
+            "SNR (dB)",
+            "Pd",
+            &[Series {
+                name: "a".into(),
+                points: vec![(0.0, 0.1), (1.0, 0.5), (2.0, f64::NAN)],
+            }],
+        )
+        .unwrap();
+        let s = std::fs::read_to_string(&p).unwrap();
+        assert!(s.starts_with("<svg") && s.contains("Pd vs SNR"));
+        histogram(
+            dir.join("h.svg"),
+            "h",
+            "x",
+            &[("a".into(), vec![0.0, 1.0, 1.0])],
+            4,
+        )
+        .unwrap();
+        assert!(line_chart(dir.join("e.svg"), "t", "x", "y", &[]).is_err());
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

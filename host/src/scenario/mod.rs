@@ -1,0 +1,33 @@
+//! Scenario presets, one module per paper's scene. A preset is data: a struct holding
+//! the paper's values and the documented choices for what the paper leaves open.
+
+use anyhow::{bail, Result};
+
+/// `(name, one-line description, preset as JSON)` of every built-in scenario.
+type Entry = (&'static str, &'static str, fn() -> serde_json::Value);
+
+const CATALOGUE: &[Entry] = &[];
+
+/// Names and descriptions of the built-in scenarios.
+pub fn catalogue() -> impl Iterator<Item = (&'static str, &'static str)> {
+    CATALOGUE.iter().map(|(n, d, _)| (*n, *d))
+}
+
+/// The preset called `name`, as JSON; an unknown name is an error that lists the
+/// known ones.
+pub fn describe(name: &str) -> Result<serde_json::Value> {
+    match CATALOGUE.iter().find(|(n, _, _)| *n == name) {
+        Some((_, _, f)) => Ok(f()),
+        None => {
+            let known: Vec<&str> = CATALOGUE.iter().map(|e| e.0).collect();
+            bail!(
+                "unknown scenario '{name}'; known scenarios: {}",
+                if known.is_empty() {
+                    "(none)".to_string()
+                } else {
+                    known.join(", ")
+                }
+            )
+        }
+    }
+}
