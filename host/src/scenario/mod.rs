@@ -3,10 +3,16 @@
 
 use anyhow::{bail, Result};
 
+pub mod six_targets;
+
 /// `(name, one-line description, preset as JSON)` of every built-in scenario.
 type Entry = (&'static str, &'static str, fn() -> serde_json::Value);
 
-const CATALOGUE: &[Entry] = &[];
+const CATALOGUE: &[Entry] = &[(
+    "six-targets",
+    "Pei et al. 2019 PSO-PHD-TBD: six CV targets, range x Doppler x azimuth power cube, 40 frames",
+    six_targets::SixTargets::describe,
+)];
 
 /// Names and descriptions of the built-in scenarios.
 pub fn catalogue() -> impl Iterator<Item = (&'static str, &'static str)> {

@@ -179,7 +179,8 @@ pub struct PsoConfig {
     pub step: f32,
     /// Fitness length scale `sqrt(c sigma_n^2)` of eq. 18, metres.
     pub fitness_scale: f32,
-    /// A particle joins the swarm if its best single-objective fitness is at least this.
+    /// A particle joins the swarm if its best single-objective fitness is at least this;
+    /// objective values below it are floored to 0.
     pub gate: f32,
     /// Half width (m) of the uniform mutation increments.
     pub mutation: f32,
@@ -291,13 +292,16 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     }
 
     /// Objective values of eq. 18 for entry `i`; returns the eq. 19 total (`w_m = 1/m`).
-    fn evaluate(&mut self, i: usize, points: &[[f32; 2]], inv_two_s2: f32) -> f32 {
+    fn evaluate(&mut self, i: usize, points: &[[f32; 2]], inv_two_s2: f32, floor: f32) -> f32 {
         let p = self.pos[i];
         let mut total = 0.0;
         for (m, z) in points.iter().enumerate().take(M) {
             let dx = p[0] - z[0];
             let dy = p[1] - z[1];
             let v = math::exp(-(dx * dx + dy * dy) * inv_two_s2);
+            // Values below the floor are set to 0: far points then tie exactly, so the
+            // sort decomposes per point (few, short fronts instead of one huge one).
+            let v = if v < floor { 0.0 } else { v };
             self.fit[i][m] = v;
             total += v;
         }
@@ -338,7 +342,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
         let inv_two_s2 = 1.0 / (2.0 * cfg.fitness_scale * cfg.fitness_scale);
         let mut mean_best = 0.0f32;
         for i in 0..n {
-            self.evaluate(i, points, inv_two_s2);
+            self.evaluate(i, points, inv_two_s2, cfg.gate);
             mean_best += self.best_objective(i, m).1;
         }
         mean_best /= n as f32;
@@ -402,7 +406,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
                 self.pbest_fit[c] = self.pbest_fit[i];
                 self.weight[c] = self.weight[i];
                 self.src[c] = self.src[i];
-                self.evaluate(c, points, inv_two_s2);
+                self.evaluate(c, points, inv_two_s2, cfg.gate);
             }
             // Elitist selection over parents + children.
             let tot = 2 * n;

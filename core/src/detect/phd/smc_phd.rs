@@ -633,8 +633,9 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             let s = self.x[i];
             let c = RadarCoords::from_state(s[0], s[1], s[2], s[3]);
             match g.cell_of(&c) {
-                Some((ir, jd, lb)) if self.w[i] > 0.0 => {
-                    self.key[i] = g.index(ir, jd, lb) as u32;
+                Some((ir, _jd, lb)) if self.w[i] > 0.0 => {
+                    // Resolution cell of eq. 25: range x azimuth (see `step`).
+                    self.key[i] = (ir * g.n_azimuth + lb) as u32;
                     let ll = cube.log_lr(&psf, &c, math::sqrt(s[4].max(0.0)), s2);
                     let l = math::ln(self.w[i]) + ll;
                     self.lw[i] = if l.is_nan() || l == f32::INFINITY {
