@@ -27,6 +27,15 @@ enum Command {
         /// Preset name, as listed by `faint scenarios`.
         name: String,
     },
+    /// Reproduce a paper's figures and tables.
+    #[command(subcommand)]
+    Reproduce(Reproduce),
+}
+
+#[derive(Subcommand, Debug)]
+enum Reproduce {
+    /// Pei et al. 2019: PSO-PHD-TBD versus PHD-TBD (Tables 2-4, Fig. 3-5).
+    Psophd(faint::host::reproduce::psophd::Args),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -43,6 +52,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!("{}", serde_json::to_string_pretty(&v)?);
             Ok(())
         }
+        Command::Reproduce(Reproduce::Psophd(a)) => faint::host::reproduce::psophd::run(&a),
     }
 }
 

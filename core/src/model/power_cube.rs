@@ -336,6 +336,31 @@ impl<'a> PowerCube<'a> {
         &self.geometry
     }
 
+    /// Like [`PowerCube::log_lr`], also returning the covered cell with the largest
+    /// factor `ln L(z | x)` (`usize::MAX` if no cell is covered).
+    #[inline]
+    pub fn log_lr_argmax(
+        &self,
+        psf: &PointSpread,
+        c: &RadarCoords,
+        amp: f32,
+        sigma2: f32,
+    ) -> (f32, usize) {
+        let mut s = 0.0f32;
+        let mut best = (usize::MAX, f32::NEG_INFINITY);
+        let data = self.data;
+        psf.for_each_cell(&self.geometry, c, |idx, h| {
+            if let Some(&z) = data.get(idx) {
+                let l = cell_log_lr(z, amp * h, sigma2);
+                s += l;
+                if l > best.1 {
+                    best = (idx, l);
+                }
+            }
+        });
+        (s, best.0)
+    }
+
     /// `sum over covered cells of ln L(z | x)` for a target at `c` with amplitude `amp`
     /// (the log of the product in eq. 20 and 24).
     #[inline]

@@ -117,6 +117,8 @@ pub struct SixTargets {
     pub noise_var: f64,
     /// Truth and filter motion noise `q1`.
     pub q_motion: f64,
+    /// Filter motion noise `q1` (the filter's own choice, see the module doc).
+    pub filter_q_motion: f64,
     /// Filter intensity noise `q2`.
     pub q_intensity: f64,
     /// Survival probability.
@@ -157,6 +159,7 @@ impl SixTargets {
             dt: 1.0,
             noise_var: 1.0,
             q_motion: 0.001,
+            filter_q_motion: 0.001,
             q_intensity: 0.01,
             p_survival: 0.98,
             p_birth: 0.02,
@@ -299,7 +302,7 @@ impl SixTargets {
             psf: self.psf,
             noise_var: self.noise_var as f32,
             dt: self.dt as f32,
-            q_motion: self.q_motion as f32,
+            q_motion: self.filter_q_motion as f32,
             q_intensity: self.q_intensity as f32,
             min_intensity: 0.05 * p,
             p_survival: self.p_survival as f32,

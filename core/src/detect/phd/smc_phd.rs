@@ -632,23 +632,24 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         for i in 0..n {
             let s = self.x[i];
             let c = RadarCoords::from_state(s[0], s[1], s[2], s[3]);
-            match g.cell_of(&c) {
-                Some((ir, _jd, lb)) if self.w[i] > 0.0 => {
-                    // Resolution cell of eq. 25: range x azimuth (see `step`).
-                    self.key[i] = (ir * g.n_azimuth + lb) as u32;
-                    let ll = cube.log_lr(&psf, &c, math::sqrt(s[4].max(0.0)), s2);
-                    let l = math::ln(self.w[i]) + ll;
-                    self.lw[i] = if l.is_nan() || l == f32::INFINITY {
-                        f32::NEG_INFINITY
-                    } else {
-                        l
-                    };
-                }
-                _ => {
-                    // Outside the surveillance cube (or zero weight): the particle dies.
-                    self.key[i] = u32::MAX;
-                    self.lw[i] = f32::NEG_INFINITY;
-                }
+            let (ll, cell) = if self.w[i] > 0.0 && g.cell_of(&c).is_some() {
+                cube.log_lr_argmax(&psf, &c, math::sqrt(s[4].max(0.0)), s2)
+            } else {
+                (0.0, usize::MAX)
+            };
+            if cell == usize::MAX {
+                // Outside the surveillance cube (or zero weight): the particle dies.
+                self.key[i] = u32::MAX;
+                self.lw[i] = f32::NEG_INFINITY;
+            } else {
+                // Resolution cell of eq. 25: the covered cell with the largest factor.
+                self.key[i] = cell as u32;
+                let l = math::ln(self.w[i]) + ll;
+                self.lw[i] = if l.is_nan() || l == f32::INFINITY {
+                    f32::NEG_INFINITY
+                } else {
+                    l
+                };
             }
             self.order[i] = i as u32;
         }
