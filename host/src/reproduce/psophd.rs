@@ -7,6 +7,8 @@
 //! frames of the std), mean OSPA on positions with `c = 50 m`, `p = 2` (Fig. 5, Table 3),
 //! and the filter's wall time per run (Table 4, cube simulation excluded).
 
+#![allow(clippy::needless_range_loop)]
+
 use std::path::PathBuf;
 use std::time::Instant;
 
