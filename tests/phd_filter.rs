@@ -164,3 +164,16 @@ fn same_seed_same_output() {
         assert_eq!(run(), run());
     });
 }
+
+#[test]
+fn a_4096_particle_filter_fits_in_1_mib_of_static_ram() {
+    // Firmware configuration: 4096 particles (e.g. 3 targets x 1000 + 500 births + slack),
+    // a swarm of 2048 parents, 8 measurement points, 8 targets. The cube itself is the
+    // caller's buffer and is not counted.
+    type Fw = SmcPhdTbd<4096, 4096, 8, 8>;
+    let bytes = std::mem::size_of::<Fw>();
+    println!("SmcPhdTbd<4096, 4096, 8, 8>: {bytes} bytes");
+    assert!(bytes < 1 << 20, "{bytes}");
+    type Host = HostFilter;
+    println!("HostFilter: {} bytes", std::mem::size_of::<Host>());
+}
