@@ -5,6 +5,7 @@ use faint::core::detect::phd::{PsoConfig, SmcPhdTbd};
 use faint::core::rng::Rng;
 use faint::core::Error;
 use faint::host::scenario::six_targets::{HostFilter, SixTargets, Variant};
+use faint::host::stats::ospa::ospa;
 
 /// The host filter is ~5 MB of fixed arrays: run on a thread with a big stack.
 fn big_stack(f: impl FnOnce() + Send + 'static) {
@@ -24,8 +25,8 @@ fn bad_cubes_are_rejected_without_touching_the_state() {
         let truth = sc.truth(&mut rng);
         let mut f = Box::new(HostFilter::new(sc.config(Variant::PsoDbscan), 1).unwrap());
         let mut cube = Vec::new();
-        for k in 0..6 {
-            sc.cube(&truth[k], &mut rng, &mut cube);
+        for frame in truth.iter().take(6) {
+            sc.cube(frame, &mut rng, &mut cube);
             f.step(&cube).unwrap();
         }
         let before: Vec<[f32; 5]> = f.particles().0.to_vec();
@@ -176,4 +177,56 @@ fn a_4096_particle_filter_fits_in_1_mib_of_static_ram() {
     assert!(bytes < 1 << 20, "{bytes}");
     type Host = HostFilter;
     println!("HostFilter: {} bytes", std::mem::size_of::<Host>());
+}
+
+/// The issue-5 goal. KNOWN FAILURE at the time of writing (measured on these seeds:
+/// mean |N_hat - N| 2.25 / 2.31 / 2.31 and mean OSPA 34.1 / 35.9 / 32.0 m for PHD-TBD /
+/// PSO + K-means / PSO + DBSCAN): the PSO variants lose tracks, PHD-TBD keeps the count
+/// closer but places K-means centres badly. Run with `--ignored`.
+#[test]
+#[ignore = "known failure: the count does not yet follow the truth at 9 dB"]
+fn at_9_db_the_count_follows_the_truth_after_settling() {
+    big_stack(|| {
+        let sc = SixTargets::new(9.0);
+        let seeds = 4u64;
+        let mut results = Vec::new();
+        for v in Variant::ALL {
+            let (mut abs_err, mut n, mut ospa_sum) = (0.0f64, 0usize, 0.0f64);
+            for seed in 0..seeds {
+                let mut rng = Rng::seed_from_u64(500 + seed);
+                let truth = sc.truth(&mut rng);
+                let mut f = Box::new(HostFilter::new(sc.config(v), 40 + seed).unwrap());
+                let mut cube = Vec::new();
+                for (k, frame) in truth.iter().enumerate() {
+                    sc.cube(frame, &mut rng, &mut cube);
+                    let r = f.step(&cube).unwrap();
+                    // Settled: frames 20..=28 (all six targets alive since frame 17).
+                    if (19..28).contains(&k) {
+                        abs_err += (r.n_hat as f64 - frame.len() as f64).abs();
+                        let est: Vec<[f64; 2]> = f
+                            .estimates()
+                            .iter()
+                            .map(|e| [e.state[0] as f64, e.state[2] as f64])
+                            .collect();
+                        let tr: Vec<[f64; 2]> =
+                            frame.iter().map(|t| [t.state[0], t.state[2]]).collect();
+                        ospa_sum += ospa(&est, &tr, 50.0, 2.0).distance;
+                        n += 1;
+                    }
+                }
+            }
+            let (mae, mo) = (abs_err / n as f64, ospa_sum / n as f64);
+            println!(
+                "{}: mean |N_hat - N| {mae:.3}, mean OSPA {mo:.2} m (frames 20-28, {seeds} seeds)",
+                v.name()
+            );
+            results.push((v, mae, mo));
+        }
+        for (v, mae, mo) in results {
+            // Bounds: a count within one target on average of the six, and an OSPA below
+            // the 50 m cut-off by a clear margin (a detector that misses everything gives 50).
+            assert!(mae < 1.0, "{}: {mae}", v.name());
+            assert!(mo < 40.0, "{}: {mo}", v.name());
+        }
+    });
 }

@@ -9,8 +9,12 @@
 //!    [`SmcPhdTbd::step`]);
 //! 4. update (eq. 20, 24-25):
 //!    `w_i <- w_i L_i / (lambda + rho_c(i))`, `L_i = prod_{covered cells} L(z | x_i)`,
-//!    `rho_c = sum_{j in cell c} w_j L_j`, `c(i)` the cell holding particle `i` — in the
-//!    log domain, grouping particles by cell with a sort (O(N) memory);
+//!    `rho_c = sum_{j in cell c} w_j L_j`, in the log domain, grouping particles by cell
+//!    with a sort and a union-find over the occupied cells (O(N) memory). Eq. 25 puts
+//!    particle `i` in the cell holding its state; here `c(i)` is the covered cell with the
+//!    largest factor `L(z | x_i)`, and with `merge_adjacent_cells` touching cells form
+//!    one group: otherwise every cell a target's energy (or its particle cloud) spreads
+//!    into claims up to one target and the count comes out 2-3x too high;
 //! 5. `N_hat = round(sum w)` (eq. 26), systematic resampling to
 //!    `clamp(per_target N_hat, min, N - J)` particles of weight `sum w / L`, and
 //!    extraction of `N_hat` states.
@@ -114,6 +118,8 @@ pub struct Config {
     pub min_particles: usize,
     /// Clutter normalisation `lambda_k` of eq. 20.
     pub clutter_lambda: f32,
+    /// Normalise over groups of touching cells instead of single cells (see `update`).
+    pub merge_adjacent_cells: bool,
     /// PSO step (`None` = plain PHD-TBD).
     pub pso: Option<PsoConfig>,
     /// State extractor.
@@ -240,6 +246,8 @@ pub struct SmcPhdTbd<const N: usize, const S: usize, const M: usize, const K: us
     key: [u32; N],
     order: [u32; N],
     anc: [u32; N],
+    run_key: [u32; N],
+    parent: [u32; N],
     pts: [[f32; 2]; N],
     swarm: Swarm<S, M>,
     dbscan: Dbscan<N>,
@@ -249,6 +257,33 @@ pub struct SmcPhdTbd<const N: usize, const S: usize, const M: usize, const K: us
     zpts: [[f32; 2]; M],
     n_z: usize,
     rng: Rng,
+}
+
+/// The 13 "forward" neighbours of a cell (the other 13 are found from the other side).
+const NEIGHBOURS: [(i64, i64, i64); 13] = [
+    (0, 0, 1),
+    (0, 1, -1),
+    (0, 1, 0),
+    (0, 1, 1),
+    (1, -1, -1),
+    (1, -1, 0),
+    (1, -1, 1),
+    (1, 0, -1),
+    (1, 0, 0),
+    (1, 0, 1),
+    (1, 1, -1),
+    (1, 1, 0),
+    (1, 1, 1),
+];
+
+/// Union-find root with path halving.
+fn find(parent: &mut [u32], mut r: usize) -> usize {
+    while parent[r] as usize != r {
+        let gp = parent[parent[r] as usize];
+        parent[r] = gp;
+        r = gp as usize;
+    }
+    r
 }
 
 #[inline]
@@ -275,6 +310,8 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             key: [0; N],
             order: [0; N],
             anc: [0; N],
+            run_key: [0; N],
+            parent: [0; N],
             pts: [[0.0; 2]; N],
             swarm: Swarm::new(),
             dbscan: Dbscan::new(),
@@ -658,35 +695,86 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             self.order[..n].sort_unstable_by_key(|&i| (key[i as usize], i));
         }
         let ln_lambda = math::ln(self.cfg.clutter_lambda);
-        let mut total = KahanSum::new();
+        // Runs of equal cell; `run_of[i]` for every particle (u32::MAX outside).
+        let mut nr = 0usize;
         let mut s = 0usize;
         while s < n {
             let k = self.key[self.order[s] as usize];
             let mut e = s;
-            let mut mx = f32::NEG_INFINITY;
             while e < n && self.key[self.order[e] as usize] == k {
-                mx = mx.max(self.lw[self.order[e] as usize]);
+                self.anc[self.order[e] as usize] = if k == u32::MAX { u32::MAX } else { nr as u32 };
                 e += 1;
             }
-            if k == u32::MAX || mx == f32::NEG_INFINITY {
-                for t in s..e {
-                    self.w[self.order[t] as usize] = 0.0;
-                }
-            } else {
-                let mut acc = KahanSum::new();
-                for t in s..e {
-                    acc.add(math::exp(self.lw[self.order[t] as usize] - mx));
-                }
-                let log_rho = mx + math::ln(acc.value());
-                let denom = log_add_exp(ln_lambda, log_rho);
-                for t in s..e {
-                    let i = self.order[t] as usize;
-                    let wi = math::exp(self.lw[i] - denom);
-                    self.w[i] = wi;
-                    total.add(wi);
-                }
+            if k != u32::MAX {
+                self.run_key[nr] = k;
+                self.parent[nr] = nr as u32;
+                nr += 1;
             }
             s = e;
+        }
+        // Merge runs whose cells touch (|d| <= 1 on every axis): one target's energy
+        // spreads over neighbouring cells, and particles attributed to either are one
+        // "resolution cell" for the normalisation of eq. 20 (else every neighbour cell
+        // claims up to one target).
+        if self.cfg.merge_adjacent_cells {
+            for r in 0..nr {
+                let (ir, jd, lb) = g.unindex(self.run_key[r] as usize);
+                for (a, b, c) in NEIGHBOURS {
+                    let (x, y, z) = (ir as i64 + a, jd as i64 + b, lb as i64 + c);
+                    if x < 0
+                        || y < 0
+                        || z < 0
+                        || x >= g.n_range as i64
+                        || y >= g.n_doppler as i64
+                        || z >= g.n_azimuth as i64
+                    {
+                        continue;
+                    }
+                    let idx = g.index(x as usize, y as usize, z as usize) as u32;
+                    if let Ok(q) = self.run_key[..nr].binary_search(&idx) {
+                        let (ra, rb) = (find(&mut self.parent, r), find(&mut self.parent, q));
+                        if ra != rb {
+                            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+                            self.parent[hi] = lo as u32;
+                        }
+                    }
+                }
+            }
+        }
+        // Per group: max log weight, then sum, then denominator (in `pts[root]`).
+        for r in 0..nr {
+            self.pts[r] = [f32::NEG_INFINITY, 0.0];
+        }
+        for i in 0..n {
+            let r = self.anc[i];
+            if r != u32::MAX {
+                let root = find(&mut self.parent, r as usize);
+                self.anc[i] = root as u32;
+                self.pts[root][0] = self.pts[root][0].max(self.lw[i]);
+            }
+        }
+        for i in 0..n {
+            let r = self.anc[i];
+            if r != u32::MAX && self.pts[r as usize][0] > f32::NEG_INFINITY {
+                self.pts[r as usize][1] += math::exp(self.lw[i] - self.pts[r as usize][0]);
+            }
+        }
+        for r in 0..nr {
+            if self.parent[r] as usize == r && self.pts[r][0] > f32::NEG_INFINITY {
+                let log_rho = self.pts[r][0] + math::ln(self.pts[r][1]);
+                self.pts[r][1] = log_add_exp(ln_lambda, log_rho);
+            }
+        }
+        let mut total = KahanSum::new();
+        for i in 0..n {
+            let r = self.anc[i];
+            let wi = if r == u32::MAX || self.lw[i] == f32::NEG_INFINITY {
+                0.0
+            } else {
+                math::exp(self.lw[i] - self.pts[r as usize][1])
+            };
+            self.w[i] = wi;
+            total.add(wi);
         }
         total.value()
     }
