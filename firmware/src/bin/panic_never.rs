@@ -1,0 +1,122 @@
+//! Link-time proof that the `faint-core` primitives contain no reachable panic (in the
+//! spirit of japaric's `panic-never`): the panic handler calls a function that does not
+//! exist, so if any panic path (bounds check, overflow check, `unwrap`, slice index...)
+//! survives optimisation, **the link fails** with an undefined reference to
+//! `faint_core_panic_path_survived`. Only meaningful with the `firmware` profile (fat LTO):
+//!
+//! ```sh
+//! cd firmware && cargo run --profile firmware --features panic-never --bin panic-never
+//! ```
+//!
+//! The binary then runs the primitives once on data from fixed seeds and exits with status
+//! 0 (1 if a call returned `Err`). It prints without `core::fmt` (formatting machinery
+//! carries its own panic paths).
+#![no_std]
+#![no_main]
+
+use core::hint::black_box;
+
+use cortex_m_rt::entry;
+use cortex_m_semihosting::{debug, hio};
+use faint_core::existence::ExistenceMarkov;
+use faint_core::math;
+use faint_core::particles::{self, Scheme};
+use faint_core::rng::Rng;
+
+const N: usize = 1000;
+
+#[entry]
+fn main() -> ! {
+    let ok = run();
+    say(if ok {
+        b"panic-never: primitives linked without a panic path and ran ok\n"
+    } else {
+        b"panic-never: a primitive returned Err\n"
+    });
+    debug::exit(if ok {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
+    #[allow(clippy::empty_loop)]
+    loop {}
+}
+
+fn run() -> bool {
+    let mut rng = Rng::from_stream(black_box(0x0FA1_4700), black_box(1));
+    let mut logs = [0f32; N];
+    let mut w = [0f32; N];
+    let mut anc = [0u16; N];
+    let mut anc32 = [0u32; N / 2];
+    let mut states = [[0f32; 4]; N];
+    for (i, s) in states.iter_mut().enumerate() {
+        *s = [i as f32, 0.0, 0.0, 1.0];
+    }
+
+    for l in logs.iter_mut() {
+        *l = 3.0 * rng.normal() + rng.uniform() - rng.exponential() + rng.gaussian(0.0, 0.1);
+    }
+    // Hide the contents and lengths from the optimiser (the proof must hold for any input).
+    let logs: &[f32] = black_box(&logs[..]);
+    let w: &mut [f32] = black_box(&mut w[..]);
+    let anc: &mut [u16] = black_box(&mut anc[..]);
+    let anc32: &mut [u32] = black_box(&mut anc32[..]);
+    let states: &mut [[f32; 4]] = black_box(&mut states[..]);
+    let mut ok = math::normalize_log_weights(logs, w).is_ok();
+    ok &= math::log_sum_exp(logs).is_ok();
+    for scheme in [
+        Scheme::Systematic,
+        Scheme::Stratified,
+        Scheme::Residual,
+        Scheme::Multinomial,
+    ] {
+        ok &= particles::resample(scheme, w, anc, &mut rng).is_ok();
+        ok &= particles::resample(scheme, w, anc32, &mut rng).is_ok();
+    }
+    ok &= particles::gather_in_place(states, anc).is_ok();
+    ok &= particles::effective_sample_size(w) > 1.0;
+    ok &= math::normalize_weights(w).is_ok();
+    ok &= math::checked_weight_sum(w).is_ok();
+    if let Ok(chain) = ExistenceMarkov::new(black_box(0.1), black_box(0.05)) {
+        let mut e = false;
+        for _ in 0..100 {
+            e = chain.sample(e, &mut rng).exists();
+        }
+        black_box(chain.predict(black_box(0.5)));
+        black_box(e);
+    } else {
+        ok = false;
+    }
+    let x = black_box(0.7f32);
+    black_box([
+        math::exp(x),
+        math::ln(x),
+        math::sqrt(x),
+        math::sin(x),
+        math::cos(x),
+        math::atan2(x, -x),
+        math::powf(x, 2.5),
+        math::floor(x),
+        math::round(x),
+        math::ln1p(x),
+        rng.uniform_range(-1.0, 1.0),
+        rng.below(17) as f32,
+    ]);
+    ok
+}
+
+fn say(msg: &[u8]) {
+    if let Ok(mut out) = hio::hstdout() {
+        let _ = out.write_all(msg);
+    }
+}
+
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo) -> ! {
+    extern "Rust" {
+        // Deliberately undefined: referencing it is the link error.
+        fn faint_core_panic_path_survived() -> !;
+    }
+    // SAFETY: never linked; a successful link proves this call is unreachable.
+    unsafe { faint_core_panic_path_survived() }
+}
