@@ -179,18 +179,15 @@ fn a_4096_particle_filter_fits_in_1_mib_of_static_ram() {
     println!("HostFilter: {} bytes", std::mem::size_of::<Host>());
 }
 
-/// The issue-5 goal. KNOWN FAILURE at the time of writing (measured on these seeds:
-/// mean |N_hat - N| 2.25 / 2.31 / 2.31 and mean OSPA 34.1 / 35.9 / 32.0 m for PHD-TBD /
-/// PSO + K-means / PSO + DBSCAN): the PSO variants lose tracks, PHD-TBD keeps the count
-/// closer but places K-means centres badly. Run with `--ignored`.
-#[test]
-#[ignore = "known failure: the count does not yet follow the truth at 9 dB"]
-fn at_9_db_the_count_follows_the_truth_after_settling() {
+/// Count error and OSPA of `variants` at 9 dB, frames 20-28 (all six targets alive since
+/// frame 17), 4 seeds; asserts the issue-5 bounds.
+fn count_follows_truth_at_9_db(variants: &[Variant]) {
+    let variants = variants.to_vec();
     big_stack(|| {
         let sc = SixTargets::new(9.0);
         let seeds = 4u64;
         let mut results = Vec::new();
-        for v in Variant::ALL {
+        for v in variants {
             let (mut abs_err, mut n, mut ospa_sum) = (0.0f64, 0usize, 0.0f64);
             for seed in 0..seeds {
                 let mut rng = Rng::seed_from_u64(500 + seed);
@@ -229,4 +226,21 @@ fn at_9_db_the_count_follows_the_truth_after_settling() {
             assert!(mo < 40.0, "{}: {mo}", v.name());
         }
     });
+}
+
+/// The issue-5 goal for PHD-TBD (measured on these seeds after the lambda = 1 and
+/// k-means++ fixes: mean |N_hat - N| 0.139, mean OSPA 16.02 m; before them 2.25 / 34.1 m).
+#[test]
+fn at_9_db_the_phd_tbd_count_follows_the_truth_after_settling() {
+    count_follows_truth_at_9_db(&[Variant::PhdTbd]);
+}
+
+/// The same goal for the PSO variants. KNOWN FAILURE (measured on these seeds: mean
+/// |N_hat - N| 2.83 / 2.75, mean OSPA 37.7 / 34.2 m for PSO + K-means / PSO + DBSCAN):
+/// the swarm's measurement points are single noisy cells and pull clouds off their
+/// targets (README, "Why we differ from the paper"). Run with `--ignored`.
+#[test]
+#[ignore = "known failure: the PSO step loses tracks at 9 dB"]
+fn at_9_db_the_pso_count_follows_the_truth_after_settling() {
+    count_follows_truth_at_9_db(&[Variant::PsoKMeans, Variant::PsoDbscan]);
 }

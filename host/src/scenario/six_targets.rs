@@ -29,10 +29,18 @@
 //!   our own count and position errors, never against the paper's tables): the filter's
 //!   motion noise is `q1 = 1` (with the paper's `0.001` nothing corrects a newborn
 //!   particle's velocity error and tracks drift out of their cells within ~10 frames);
-//!   clutter normalisation `lambda = 100`; particles are attributed to the covered cell
+//!   particles are attributed to the covered cell
 //!   with the largest likelihood-ratio factor and touching cells are normalised together
 //!   (with the cell holding the particle's state, each cell a target's energy spreads
 //!   into claimed up to one target: counts 2-3x the truth).
+//! - **Clutter normalisation** `lambda_k = 1` (eq. 20): eq. 20-24 are written with the
+//!   likelihood *ratio* `L = p(z | x) / g(z)` (eq. 21 over eq. 23). A TBD cell always
+//!   holds the noise-only return, so the clutter term of the PHD update's denominator,
+//!   divided by the same `g(z)`, is 1 (and `E[L] = 1` under noise alone). A group's
+//!   updated mass is `rho / (lambda + rho)`: with the earlier `lambda = 100` a track
+//!   whose particles momentarily see `rho < 100` (one frame with a weak return or a
+//!   velocity error of a few Doppler cells) lost ~99 % of its mass in one frame, which
+//!   is how 9 dB tracks were lost (per-frame diagnostics: `examples/phd_diag.rs`).
 
 use faint_core::detect::phd::{
     BirthComponent, BirthMode, BirthModel, Config, DbscanParams, Extractor, PsoConfig,
@@ -229,7 +237,7 @@ impl SixTargets {
             "birth_std": [20.0, 20.0, 20.0, 20.0],
             "birth_mode": "measurement-driven: 8 strongest cells per component window, tangential velocity N(0, 40^2)",
             "birth_intensity": "U[0.75 P, 1.25 P]",
-            "clutter_lambda": 100.0,
+            "clutter_lambda": 1.0,
             "filter_q_motion": 1.0,
             "merge_adjacent_cells": true,
             "pso": format!("{:?}", PsoConfig::paper()),
@@ -334,7 +342,7 @@ impl SixTargets {
             },
             particles_per_target: self.particles_per_target,
             min_particles: self.birth_particles,
-            clutter_lambda: 100.0,
+            clutter_lambda: 1.0,
             merge_adjacent_cells: true,
             pso: match variant {
                 Variant::PhdTbd => None,

@@ -1,12 +1,17 @@
 //! K-means (Lloyd) on 2-D points, the baseline state extractor (Pei et al. 2019 §3.2).
 //!
-//! Deterministic seeding (no random draws, so host and target agree): the first centre
-//! is the point farthest from the mean, each next one the point farthest from its
-//! nearest chosen centre (maximin / farthest-first). Then at most `max_iter` Lloyd
+//! Seeding: k-means++ (Arthur & Vassilvitskii 2007): the first centre is a uniformly drawn
+//! point, each next one a point drawn with probability proportional to its squared
+//! distance to the nearest chosen centre, from the caller's [`Rng`] (so host and target
+//! agree bit for bit for the same seed). Farthest-first (maximin) seeding was used
+//! before and picked single stray particles (births, resampling stragglers 300-600 m
+//! away) as centres, merging two real targets into one cluster; k-means++ weighs a
+//! candidate by how many particles sit there. Then at most `max_iter` Lloyd
 //! iterations, stopping when no assignment changes. Memory: one `u16` label per point.
 
 #![allow(clippy::needless_range_loop)]
 
+use crate::rng::Rng;
 use crate::{Error, Result};
 
 /// K-means workspace for up to `N` points and `K` clusters.
@@ -42,10 +47,25 @@ impl<const N: usize, const K: usize> KMeans<N, K> {
         }
     }
 
+    #[inline]
+    fn nearest_d2(&self, p: [f32; 2], c: usize) -> f32 {
+        let mut dn = f32::INFINITY;
+        for &q in &self.centres[..c] {
+            dn = dn.min(d2(p, q));
+        }
+        dn
+    }
+
     /// Clusters `pts` into `k` groups (`k <= K`, `k <= pts.len()`, else clamped);
     /// returns the number of centres. Errors: [`Error::Capacity`] for more than `N`
     /// points, [`Error::NonFinite`].
-    pub fn run(&mut self, pts: &[[f32; 2]], k: usize, max_iter: usize) -> Result<usize> {
+    pub fn run(
+        &mut self,
+        pts: &[[f32; 2]],
+        k: usize,
+        max_iter: usize,
+        rng: &mut Rng,
+    ) -> Result<usize> {
         let n = pts.len();
         if n > N {
             return Err(Error::Capacity {
@@ -57,36 +77,31 @@ impl<const N: usize, const K: usize> KMeans<N, K> {
         if k == 0 {
             return Ok(0);
         }
-        let (mut mx, mut my) = (0.0f64, 0.0f64);
         for p in pts {
             if !(p[0].is_finite() && p[1].is_finite()) {
                 return Err(Error::NonFinite);
             }
-            mx += p[0] as f64;
-            my += p[1] as f64;
         }
-        let mean = [(mx / n as f64) as f32, (my / n as f64) as f32];
-        // Farthest-first seeding.
-        let mut far = (0usize, -1.0f32);
-        for (i, &p) in pts.iter().enumerate() {
-            let d = d2(p, mean);
-            if d > far.1 {
-                far = (i, d);
-            }
-        }
-        self.centres[0] = pts[far.0];
+        // k-means++ seeding.
+        self.centres[0] = pts[(rng.below(n as u32) as usize).min(n - 1)];
         for c in 1..k {
-            let mut best = (0usize, -1.0f32);
-            for (i, &p) in pts.iter().enumerate() {
-                let mut dn = f32::INFINITY;
-                for &q in &self.centres[..c] {
-                    dn = dn.min(d2(p, q));
-                }
-                if dn > best.1 {
-                    best = (i, dn);
+            let mut total = 0.0f64;
+            for &p in pts {
+                total += self.nearest_d2(p, c) as f64;
+            }
+            let mut pick = n - 1;
+            if total > 0.0 {
+                let target = rng.uniform() as f64 * total;
+                let mut acc = 0.0f64;
+                for (i, &p) in pts.iter().enumerate() {
+                    acc += self.nearest_d2(p, c) as f64;
+                    if acc > target {
+                        pick = i;
+                        break;
+                    }
                 }
             }
-            self.centres[c] = pts[best.0];
+            self.centres[c] = pts[pick];
         }
         for a in self.assign[..n].iter_mut() {
             *a = u16::MAX;

@@ -116,7 +116,8 @@ pub struct Config {
     pub particles_per_target: usize,
     /// Particles kept when `N_hat` is 0.
     pub min_particles: usize,
-    /// Clutter normalisation `lambda_k` of eq. 20.
+    /// Clutter normalisation `lambda_k` of eq. 20. With the likelihood-ratio form of
+    /// eq. 21-23 (every cell holds the noise-only return) the principled value is 1.
     pub clutter_lambda: f32,
     /// Normalise over groups of touching cells instead of single cells (see `update`).
     pub merge_adjacent_cells: bool,
@@ -855,7 +856,9 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                 })?;
             }
             Extractor::KMeans { max_iter } => {
-                let k = self.kmeans.run(&self.pts[..n], n_hat, max_iter)?;
+                let k = self
+                    .kmeans
+                    .run(&self.pts[..n], n_hat, max_iter, &mut self.rng)?;
                 let mut acc = [[0.0f32; 5]; K];
                 for i in 0..n {
                     let c = self.kmeans.assign[i] as usize;
