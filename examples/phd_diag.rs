@@ -19,11 +19,18 @@ fn main() {
     if let Some(l) = lambda {
         cfg.clutter_lambda = l;
     }
+    // Seeds >= 500 replay `tests/phd_filter.rs` (one stream for truth and cubes).
     let mut seed_rng = Rng::from_stream(2019, seed);
-    let mut truth_rng = seed_rng.fork(1);
-    let mut cube_rng = seed_rng.fork(2);
-    let truth = sc.truth(&mut truth_rng);
-    let mut f = Box::new(HostFilter::new(cfg, seed_rng.fork(10).next_u64()).unwrap());
+    let (truth, mut cube_rng, fseed) = if seed >= 500 {
+        let mut r = Rng::seed_from_u64(seed);
+        let t = sc.truth(&mut r);
+        (t, r, 40 + seed - 500)
+    } else {
+        let mut truth_rng = seed_rng.fork(1);
+        let t = sc.truth(&mut truth_rng);
+        (t, seed_rng.fork(2), seed_rng.fork(10).next_u64())
+    };
+    let mut f = Box::new(HostFilter::new(cfg, fseed).unwrap());
     let mut cube = Vec::new();
     let g = sc.geometry();
     let psf = sc.psf();

@@ -379,7 +379,11 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
     /// are rejected before any state changes.
     ///
     /// PSO variant, measurement-derived points `Z_m`: the cells holding the predicted
-    /// *surviving* particles are ranked by power and the strongest `points` of them,
+    /// *surviving* particles are ranked by the point-spread-matched power
+    /// `sum_{covered cells} h^2 z` of a target at the cell centre (the TBD statistic;
+    /// a single cell's power at 9 dB is matched by the strongest noise cell among the
+    /// few hundred cells a predicted cloud covers, and the swarm then pulled whole
+    /// clouds onto noise) and the strongest `points` of them,
     /// thinned so that no two lie within one range and one azimuth cell of each other,
     /// are mapped to the Cartesian centre of their range/azimuth cell. Restricting the
     /// candidates to the predicted PHD support keeps single-frame noise peaks elsewhere
@@ -554,20 +558,46 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         let g = *cube.geometry();
         let data = cube.data();
         let want = want.min(M);
-        // (z, ir, lb) sorted descending by z.
-        let mut top = [(0.0f32, 0usize, 0usize); M];
+        let psf = self.cfg.psf;
+        // (z, ir, lb, jd) sorted descending by z.
+        let mut top = [(0.0f32, 0usize, 0usize, 0usize); M];
         let mut nt = 0usize;
+        let mut last_cell = usize::MAX;
         for i in 0..n_surv {
             let s = self.x[i];
             let c = RadarCoords::from_state(s[0], s[1], s[2], s[3]);
             let Some((ir, jd, lb)) = g.cell_of(&c) else {
                 continue;
             };
-            let z = data[g.index(ir, jd, lb)];
+            let cell = g.index(ir, jd, lb);
+            if cell == last_cell {
+                continue;
+            }
+            last_cell = cell;
+            // Point-spread-matched statistic `sum h^2 z` over the cells a target at the
+            // cell centre would cover (the small-signal form of the log likelihood
+            // ratio, `ln I0(x) ~ x^2 / 4`), not the single cell's power.
+            let centre = RadarCoords {
+                range: g.range_centre(ir),
+                doppler: g.doppler_centre(jd),
+                azimuth_deg: g.azimuth_centre(lb),
+            };
+            let mut z = 0.0f32;
+            psf.for_each_cell(&g, &centre, |idx, h| {
+                if let Some(&v) = data.get(idx) {
+                    z += h * h * v;
+                }
+            });
             if nt == want && z <= top[nt - 1].0 {
                 continue;
             }
-            let near = |e: &(f32, usize, usize)| e.1.abs_diff(ir) <= 1 && e.2.abs_diff(lb) <= 1;
+            // Thinning in range, azimuth *and* Doppler: targets born at the same place
+            // (Table 1: three at (250, 1500), three at (1750, 500)) share range/azimuth
+            // cells for several frames but not Doppler cells; thinning on position alone
+            // left one point for two targets and the swarm merged their clouds.
+            let near = |e: &(f32, usize, usize, usize)| {
+                e.1.abs_diff(ir) <= 1 && e.2.abs_diff(lb) <= 1 && e.3.abs_diff(jd) <= 1
+            };
             if top[..nt].iter().any(|e| near(e) && e.0 >= z) {
                 continue;
             }
@@ -588,7 +618,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                 top[p] = top[p - 1];
                 p -= 1;
             }
-            top[p] = (z, ir, lb);
+            top[p] = (z, ir, lb, jd);
         }
         for (k, e) in top[..nt].iter().enumerate() {
             let (x, y) = g.cell_position(e.1, e.2);
