@@ -19,6 +19,13 @@ fn main() {
     if let Some(l) = lambda {
         cfg.clutter_lambda = l;
     }
+    // Optional PSO fitness gate override (diagnostic only).
+    if let (Some(gate), Some(p)) = (
+        a.get(5).and_then(|s| s.parse::<f32>().ok()),
+        cfg.pso.as_mut(),
+    ) {
+        p.gate = gate;
+    }
     // Seeds >= 500 replay `tests/phd_filter.rs` (one stream for truth and cubes).
     let mut seed_rng = Rng::from_stream(2019, seed);
     let (truth, mut cube_rng, fseed) = if seed >= 500 {
@@ -40,12 +47,14 @@ fn main() {
         let pc = PowerCube::new(&cube, g).unwrap();
         let (x, w) = f.particles();
         let mut line = format!(
-            "k={:2} N={} nhat={} mass={:.2} np={:5} |",
+            "k={:2} N={} nhat={} mass={:.2} np={:5} sw={} gen={} |",
             k + 1,
             frame.len(),
             rep.n_hat,
             rep.mass,
-            x.len()
+            x.len(),
+            rep.swarm,
+            rep.pso_generations
         );
         for t in frame {
             let s = t.state;
