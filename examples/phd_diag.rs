@@ -104,7 +104,10 @@ fn main() {
                     .sqrt()
                 })
                 .fold(f64::INFINITY, f64::min);
-            line += &format!(" {:.0}({})", dmin, e.support);
+            line += &format!(
+                " {:.0}({})@({:.0},{:.0})",
+                dmin, e.support, e.state[0], e.state[2]
+            );
         }
         println!("{line}");
     }

@@ -258,6 +258,9 @@ pub struct SmcPhdTbd<const N: usize, const S: usize, const M: usize, const K: us
     zpts: [[f32; 2]; M],
     n_z: usize,
     rng: Rng,
+    /// Measurement-driven birth cells chosen on the previous frame, per component.
+    birth_cells: [[(usize, f32); MAX_BIRTH_CELLS]; MAX_BIRTH_COMPONENTS],
+    birth_nb: [usize; MAX_BIRTH_COMPONENTS],
 }
 
 /// The 13 "forward" neighbours of a cell (the other 13 are found from the other side).
@@ -322,6 +325,8 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             zpts: [[0.0; 2]; M],
             n_z: 0,
             rng: Rng::seed_from_u64(seed),
+            birth_cells: [[(0, 0.0); MAX_BIRTH_CELLS]; MAX_BIRTH_COMPONENTS],
+            birth_nb: [0; MAX_BIRTH_COMPONENTS],
         })
     }
 
@@ -352,6 +357,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         self.n = 0;
         self.n_est = 0;
         self.rng = Rng::seed_from_u64(seed);
+        self.birth_nb = [0; MAX_BIRTH_COMPONENTS];
     }
 
     /// The configuration.
@@ -396,7 +402,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         let mut report = Report::default();
         self.predict();
         let n_surv = self.n;
-        self.add_births(&cube);
+        self.add_births();
         if let Some(pso) = self.cfg.pso {
             self.select_points(&cube, n_surv, pso.points);
             let (sw, gens) = self.swarm_step(&pso);
@@ -420,6 +426,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         }
         report.particles = self.n;
         self.extract(report.n_hat)?;
+        self.choose_birth_cells(&cube);
         report.estimates = self.n_est;
         Ok(report)
     }
@@ -445,7 +452,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         }
     }
 
-    fn add_births(&mut self, cube: &PowerCube<'_>) {
+    fn add_births(&mut self) {
         let b = self.cfg.birth;
         let g = self.cfg.geometry;
         let j = b.particles.min(N - self.n);
@@ -458,18 +465,14 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         for ci in 0..nc {
             let comp = b.components[ci];
             let count = j / nc + usize::from(ci < j % nc);
-            // Measurement-driven: strongest cells in the component's window.
-            let mut cells = [(0usize, 0.0f32); MAX_BIRTH_CELLS];
-            let mut nb = 0usize;
-            let mut tang = 0.0f32;
-            if let BirthMode::Measurement {
-                cells: want,
-                tangential_std,
-            } = b.mode
-            {
-                tang = tangential_std;
-                nb = Self::strongest_in_window(cube, &g, &comp, &mut cells[..want]);
-            }
+            // Measurement-driven: strongest cells of the component's window on the
+            // *previous* frame, propagated one step (`choose_birth_cells`).
+            let cells = self.birth_cells[ci];
+            let nb = self.birth_nb[ci];
+            let tang = match b.mode {
+                BirthMode::Measurement { tangential_std, .. } => tangential_std,
+                BirthMode::Gaussian => 0.0,
+            };
             for _ in 0..count {
                 let s = if nb > 0 {
                     let (idx, _) = cells[self.rng.below(nb as u32) as usize];
@@ -481,7 +484,9 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                         / DEG_PER_RAD;
                     let (sb, cb) = (math::sin(az), math::cos(az));
                     let vt = tang * self.rng.normal();
-                    [r * cb, d * cb - vt * sb, r * sb, d * sb + vt * cb]
+                    let (vx, vy) = (d * cb - vt * sb, d * sb + vt * cb);
+                    let t = self.cfg.dt;
+                    [r * cb + t * vx, vx, r * sb + t * vy, vy]
                 } else {
                     let mut s = [0.0f32; 4];
                     for (d, v) in s.iter_mut().enumerate() {
@@ -499,6 +504,29 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
     }
 
     /// Top cells by power inside the `3 sigma` position window of `comp`.
+    /// Measurement-driven birth: picks each component's strongest cells on this frame
+    /// for the births of the *next* frame. Births placed on a frame's strongest cells and
+    /// updated with the same frame use the data twice: their likelihood ratio is biased
+    /// up by the selection (the strongest noise cells of a ~4500-cell window look like a
+    /// target), and noise births were confirmed as persistent false tracks at the birth
+    /// windows. Drawing from the previous frame (Ristic, Clark, Vo, Vo 2012, adaptive
+    /// target birth) keeps the update's data independent of where births were placed.
+    fn choose_birth_cells(&mut self, cube: &PowerCube<'_>) {
+        let b = self.cfg.birth;
+        let g = self.cfg.geometry;
+        for ci in 0..b.n_components.min(MAX_BIRTH_COMPONENTS) {
+            self.birth_nb[ci] = match b.mode {
+                BirthMode::Measurement { cells: want, .. } => Self::strongest_in_window(
+                    cube,
+                    &g,
+                    &b.components[ci],
+                    &mut self.birth_cells[ci][..want.min(MAX_BIRTH_CELLS)],
+                ),
+                BirthMode::Gaussian => 0,
+            };
+        }
+    }
+
     fn strongest_in_window(
         cube: &PowerCube<'_>,
         g: &CubeGeometry,
