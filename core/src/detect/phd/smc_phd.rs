@@ -519,6 +519,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                 BirthMode::Measurement { cells: want, .. } => Self::strongest_in_window(
                     cube,
                     &g,
+                    &self.cfg.psf,
                     &b.components[ci],
                     &mut self.birth_cells[ci][..want.min(MAX_BIRTH_CELLS)],
                 ),
@@ -530,6 +531,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
     fn strongest_in_window(
         cube: &PowerCube<'_>,
         g: &CubeGeometry,
+        psf: &PointSpread,
         comp: &BirthComponent,
         out: &mut [(usize, f32)],
     ) -> usize {
@@ -564,7 +566,19 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             for jd in 0..g.n_doppler {
                 for lb in b0..b1 {
                     let idx = g.index(ir, jd, lb);
-                    let z = data[idx];
+                    // Point-spread-matched statistic `sum h^2 z` of a target at the cell
+                    // centre, as for the swarm's points.
+                    let centre = RadarCoords {
+                        range: g.range_centre(ir),
+                        doppler: g.doppler_centre(jd),
+                        azimuth_deg: g.azimuth_centre(lb),
+                    };
+                    let mut z = 0.0f32;
+                    psf.for_each_cell(g, &centre, |i, h| {
+                        if let Some(&v) = data.get(i) {
+                            z += h * h * v;
+                        }
+                    });
                     if n < out.len() {
                         out[n] = (idx, z);
                         n += 1;
