@@ -23,7 +23,8 @@
 //!   `(1750, 500)`. The paper's velocity spread (20 m/s around 0) leaves the targets'
 //!   speeds of up to 69 m/s at 2-3.4 sigma, so the preset uses the measurement-driven
 //!   birth mode (radial velocity from the Doppler cell, tangential `N(0, 40^2)`), drawn
-//!   from the 8 strongest cells inside each component's 3-sigma window on the previous
+//!   from the 8 strongest cells (by the point-spread-matched `sum h^2 z`) inside each
+//!   component's 3-sigma window on the previous
 //!   frame, propagated one step (not the frame used to update them). Birth mass
 //!   `Pb = 0.02` per component per frame, 500 birth particles.
 //! - **Filter choices** (not in the paper; picked on 3 seeds of this preset at 9 dB by

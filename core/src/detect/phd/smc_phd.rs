@@ -49,10 +49,11 @@ pub struct BirthComponent {
 pub enum BirthMode {
     /// From the Gaussian mixture (equal component weights), as in the paper.
     Gaussian,
-    /// Measurement-driven: per component, the `cells` strongest cells inside the
-    /// component's `3 sigma` position window (all Doppler cells); a birth particle is
-    /// uniform inside one of them (range, azimuth, radial velocity) with a tangential
-    /// velocity `N(0, tangential_std^2)`.
+    /// Measurement-driven: per component, the `cells` strongest cells of the previous
+    /// frame inside the component's `3 sigma` position window (all Doppler cells), ranked
+    /// by the point-spread-matched statistic `sum h^2 z`; a birth particle is uniform
+    /// inside one of them (range, azimuth, radial velocity) with a tangential velocity
+    /// `N(0, tangential_std^2)`, propagated one CV step.
     Measurement {
         /// Strongest cells kept per component (1..=16).
         cells: usize,
