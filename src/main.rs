@@ -38,6 +38,8 @@ enum Reproduce {
     Crpf(faint::host::reproduce::crpf::Args),
     /// MHT-TBD (modified Hough transform) in dense sea clutter, with the classic Hough TBD.
     Mht(faint::host::reproduce::mht::Args),
+    /// Pei et al. 2019: PSO-PHD-TBD versus PHD-TBD (Tables 2-4, Fig. 3-5).
+    Psophd(faint::host::reproduce::psophd::Args),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -57,6 +59,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Reproduce(r) => match r {
             Reproduce::Crpf(a) => faint::host::reproduce::crpf::run(&a),
             Reproduce::Mht(a) => faint::host::reproduce::mht::run(&a),
+            Reproduce::Psophd(a) => faint::host::reproduce::psophd::run(&a),
         },
     }
 }

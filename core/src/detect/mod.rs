@@ -4,3 +4,4 @@ pub mod crpf;
 pub mod hough;
 pub mod pf_lrt;
 pub mod pf_tbd;
+pub mod phd;

@@ -1,3 +1,4 @@
 //! Observation and motion models: the per-frame inputs detectors consume.
 pub mod doppler;
 pub mod plot;
+pub mod power_cube;

@@ -4,3 +4,4 @@
 
 pub mod crpf;
 pub mod mht;
+pub mod psophd;

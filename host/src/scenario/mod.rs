@@ -5,6 +5,7 @@ use anyhow::{bail, Result};
 
 pub mod othr;
 pub mod sea_clutter;
+pub mod six_targets;
 
 /// `(name, one-line description, preset as JSON)` of every built-in scenario.
 type Entry = (&'static str, &'static str, fn() -> serde_json::Value);
@@ -17,6 +18,10 @@ const CATALOGUE: &[Entry] = &[(
     "sea-clutter",
     "MHT-TBD (Bao et al. 2022): 6 km x 6 km sea surface, 5 CV targets, Poisson clutter (shown at lambda = 398)",
     || serde_json::to_value(sea_clutter::SeaClutter::paper(398.0)).unwrap_or_default(),
+), (
+    "six-targets",
+    "Pei et al. 2019 PSO-PHD-TBD: six CV targets, range x Doppler x azimuth power cube, 40 frames",
+    six_targets::SixTargets::describe,
 )];
 
 /// Names and descriptions of the built-in scenarios.

@@ -1,0 +1,274 @@
+//! DBSCAN (Ester et al. 1996; Pei et al. 2019 §2.2) on 2-D points with a grid index.
+//!
+//! Neighbourhood: `|p - q| <= eps` (a point is its own neighbour); core point: at least
+//! `min_pts` neighbours. The grid has square cells of side `0.7 eps` (< `eps / sqrt 2`),
+//! so all points sharing a grid cell are neighbours; a query scans the 5 x 5 block of
+//! cells around a point. A grid cell holding `>= min_pts` points makes all of them core
+//! without distance checks, and cells whose points are all labelled are skipped during
+//! expansion, so dense particle clouds cost near-linear time. Memory: O(N) fixed arrays.
+
+#![allow(clippy::needless_range_loop)]
+
+use crate::{Error, Result};
+
+const UNVISITED: i32 = -2;
+/// Label of a noise point.
+pub const NOISE: i32 = -1;
+
+/// DBSCAN parameters: radius `E` and density threshold `Th_min`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DbscanParams {
+    /// Neighbourhood radius `E` (m).
+    pub eps: f32,
+    /// Minimum neighbourhood size (including the point) of a core point, `Th_min`.
+    pub min_pts: usize,
+}
+
+impl DbscanParams {
+    /// Checks `eps > 0` finite and `min_pts >= 1`.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.eps.is_finite() && self.eps > 0.0) {
+            return Err(Error::InvalidConfig("dbscan eps must be positive"));
+        }
+        if self.min_pts == 0 {
+            return Err(Error::InvalidConfig("dbscan min_pts must be >= 1"));
+        }
+        Ok(())
+    }
+}
+
+/// Grid-indexed DBSCAN workspace for up to `N` points.
+#[derive(Debug, Clone)]
+pub struct Dbscan<const N: usize> {
+    key: [u64; N],
+    order: [u32; N],
+    run_of: [u32; N],
+    run_start: [u32; N],
+    run_len: [u32; N],
+    run_key: [u64; N],
+    run_free: [u32; N],
+    core: [u8; N],
+    /// Label per point after [`Dbscan::run`]: cluster id `>= 0` or [`NOISE`].
+    pub labels: [i32; N],
+    queue: [u32; N],
+    n_runs: usize,
+}
+
+impl<const N: usize> Default for Dbscan<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+#[inline]
+fn pack(gx: u32, gy: u32) -> u64 {
+    ((gx as u64) << 32) | gy as u64
+}
+
+impl<const N: usize> Dbscan<N> {
+    /// Empty workspace.
+    pub const fn new() -> Self {
+        Self {
+            key: [0; N],
+            order: [0; N],
+            run_of: [0; N],
+            run_start: [0; N],
+            run_len: [0; N],
+            run_key: [0; N],
+            run_free: [0; N],
+            core: [0; N],
+            labels: [0; N],
+            queue: [0; N],
+            n_runs: 0,
+        }
+    }
+
+    /// First run with key >= `k`.
+    #[inline]
+    fn lower_run(&self, k: u64) -> usize {
+        self.run_key[..self.n_runs].partition_point(|&x| x < k)
+    }
+
+    /// Calls `f(run)` for the runs of the 5 x 5 grid block around grid cell `(gx, gy)`.
+    #[inline]
+    fn for_block(&self, gx: u32, gy: u32, mut f: impl FnMut(usize) -> bool) {
+        for dx in -2i64..=2 {
+            let x = gx as i64 + dx;
+            if !(0..=u32::MAX as i64).contains(&x) {
+                continue;
+            }
+            let ylo = (gy as i64 - 2).max(0) as u32;
+            let yhi = (gy as i64 + 2).min(u32::MAX as i64) as u32;
+            let mut r = self.lower_run(pack(x as u32, ylo));
+            let end = pack(x as u32, yhi);
+            while r < self.n_runs && self.run_key[r] <= end {
+                if !f(r) {
+                    return;
+                }
+                r += 1;
+            }
+        }
+    }
+
+    fn is_core(&mut self, p: usize, pts: &[[f32; 2]], eps2: f32, min_pts: usize) -> bool {
+        if self.core[p] != 0 {
+            return self.core[p] == 1;
+        }
+        let own = self.run_of[p] as usize;
+        let mut count = self.run_len[own] as usize;
+        if count < min_pts {
+            let k = self.key[p];
+            let (gx, gy) = ((k >> 32) as u32, k as u32);
+            let pp = pts[p];
+            self.for_block(gx, gy, |r| {
+                if r != own {
+                    let s = self.run_start[r] as usize;
+                    for &q in &self.order[s..s + self.run_len[r] as usize] {
+                        let q = pts[q as usize];
+                        let (dx, dy) = (q[0] - pp[0], q[1] - pp[1]);
+                        if dx * dx + dy * dy <= eps2 {
+                            count += 1;
+                        }
+                    }
+                }
+                count < min_pts
+            });
+        }
+        let c = count >= min_pts;
+        self.core[p] = if c { 1 } else { 2 };
+        c
+    }
+
+    /// Clusters `pts` (at most `N`; NaN/inf coordinates are [`Error::NonFinite`]).
+    ///
+    /// Calls `on_cluster(members)` once per cluster, in discovery order (points visited
+    /// in input order), with the member indices; returns the number of clusters. Labels
+    /// are left in [`Dbscan::labels`]. Border points reachable from two clusters go to
+    /// the first that reaches them (as in the original algorithm).
+    pub fn run(
+        &mut self,
+        pts: &[[f32; 2]],
+        params: &DbscanParams,
+        mut on_cluster: impl FnMut(&[u32]),
+    ) -> Result<usize> {
+        params.validate()?;
+        let n = pts.len();
+        if n > N {
+            return Err(Error::Capacity {
+                capacity: N,
+                requested: n,
+            });
+        }
+        if n == 0 {
+            return Ok(0);
+        }
+        let (mut minx, mut miny) = (f32::INFINITY, f32::INFINITY);
+        for p in pts {
+            if !(p[0].is_finite() && p[1].is_finite()) {
+                return Err(Error::NonFinite);
+            }
+            minx = minx.min(p[0]);
+            miny = miny.min(p[1]);
+        }
+        let side = 0.7 * params.eps;
+        let eps2 = params.eps * params.eps;
+        let grid = |v: f32, lo: f32| -> Result<u32> {
+            let g = (v - lo) / side;
+            if g >= 4.0e9 {
+                return Err(Error::InvalidConfig("dbscan: point extent over 4e9 eps"));
+            }
+            Ok(g as u32)
+        };
+        for (i, p) in pts.iter().enumerate() {
+            self.key[i] = pack(grid(p[0], minx)?, grid(p[1], miny)?);
+            self.order[i] = i as u32;
+            self.labels[i] = UNVISITED;
+            self.core[i] = 0;
+        }
+        {
+            let key = &self.key;
+            self.order[..n].sort_unstable_by_key(|&i| (key[i as usize], i));
+        }
+        self.n_runs = 0;
+        let mut s = 0usize;
+        while s < n {
+            let k = self.key[self.order[s] as usize];
+            let mut e = s;
+            while e < n && self.key[self.order[e] as usize] == k {
+                self.run_of[self.order[e] as usize] = self.n_runs as u32;
+                e += 1;
+            }
+            let r = self.n_runs;
+            self.run_start[r] = s as u32;
+            self.run_len[r] = (e - s) as u32;
+            self.run_free[r] = (e - s) as u32;
+            self.run_key[r] = k;
+            self.n_runs += 1;
+            s = e;
+        }
+        let mut clusters = 0usize;
+        let mut qlen = 0usize;
+        for p in 0..n {
+            if self.labels[p] != UNVISITED {
+                continue;
+            }
+            if !self.is_core(p, pts, eps2, params.min_pts) {
+                self.labels[p] = NOISE;
+                continue;
+            }
+            let id = clusters as i32;
+            clusters += 1;
+            let start = qlen;
+            self.labels[p] = id;
+            self.run_free[self.run_of[p] as usize] -= 1;
+            self.queue[qlen] = p as u32;
+            qlen += 1;
+            let mut head = start;
+            while head < qlen {
+                let q = self.queue[head] as usize;
+                head += 1;
+                if !self.is_core(q, pts, eps2, params.min_pts) {
+                    continue;
+                }
+                let k = self.key[q];
+                let (gx, gy) = ((k >> 32) as u32, k as u32);
+                let pq = pts[q];
+                let own = self.run_of[q] as usize;
+                let mut r_lo = 0usize;
+                // Collect the block's runs first (borrowck: for_block borrows self).
+                let mut runs = [0u32; 25];
+                self.for_block(gx, gy, |r| {
+                    if r_lo < 25 {
+                        runs[r_lo] = r as u32;
+                        r_lo += 1;
+                    }
+                    true
+                });
+                for &r in &runs[..r_lo] {
+                    let r = r as usize;
+                    if self.run_free[r] == 0 {
+                        continue;
+                    }
+                    let st = self.run_start[r] as usize;
+                    for t in st..st + self.run_len[r] as usize {
+                        let o = self.order[t] as usize;
+                        let lab = self.labels[o];
+                        if lab != UNVISITED && lab != NOISE {
+                            continue;
+                        }
+                        let po = pts[o];
+                        let (dx, dy) = (po[0] - pq[0], po[1] - pq[1]);
+                        if r == own || dx * dx + dy * dy <= eps2 {
+                            self.labels[o] = id;
+                            self.run_free[r] -= 1;
+                            self.queue[qlen] = o as u32;
+                            qlen += 1;
+                        }
+                    }
+                }
+            }
+            on_cluster(&self.queue[start..qlen]);
+        }
+        Ok(clusters)
+    }
+}

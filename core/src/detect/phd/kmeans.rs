@@ -1,0 +1,144 @@
+//! K-means (Lloyd) on 2-D points, the baseline state extractor (Pei et al. 2019 §3.2).
+//!
+//! Seeding: k-means++ (Arthur & Vassilvitskii 2007): the first centre is a uniformly drawn
+//! point, each next one a point drawn with probability proportional to its squared
+//! distance to the nearest chosen centre, from the caller's [`Rng`] (so host and target
+//! agree bit for bit for the same seed). Farthest-first (maximin) seeding was used
+//! before and picked single stray particles (births, resampling stragglers 300-600 m
+//! away) as centres, merging two real targets into one cluster; k-means++ weighs a
+//! candidate by how many particles sit there. Then at most `max_iter` Lloyd
+//! iterations, stopping when no assignment changes. Memory: one `u16` label per point.
+
+#![allow(clippy::needless_range_loop)]
+
+use crate::rng::Rng;
+use crate::{Error, Result};
+
+/// K-means workspace for up to `N` points and `K` clusters.
+#[derive(Debug, Clone)]
+pub struct KMeans<const N: usize, const K: usize> {
+    /// Cluster of each point after [`KMeans::run`].
+    pub assign: [u16; N],
+    /// Centres.
+    pub centres: [[f32; 2]; K],
+    /// Points per centre.
+    pub counts: [u32; K],
+}
+
+impl<const N: usize, const K: usize> Default for KMeans<N, K> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+#[inline]
+fn d2(a: [f32; 2], b: [f32; 2]) -> f32 {
+    let (dx, dy) = (a[0] - b[0], a[1] - b[1]);
+    dx * dx + dy * dy
+}
+
+impl<const N: usize, const K: usize> KMeans<N, K> {
+    /// Empty workspace.
+    pub const fn new() -> Self {
+        Self {
+            assign: [0; N],
+            centres: [[0.0; 2]; K],
+            counts: [0; K],
+        }
+    }
+
+    #[inline]
+    fn nearest_d2(&self, p: [f32; 2], c: usize) -> f32 {
+        let mut dn = f32::INFINITY;
+        for &q in &self.centres[..c] {
+            dn = dn.min(d2(p, q));
+        }
+        dn
+    }
+
+    /// Clusters `pts` into `k` groups (`k <= K`, `k <= pts.len()`, else clamped);
+    /// returns the number of centres. Errors: [`Error::Capacity`] for more than `N`
+    /// points, [`Error::NonFinite`].
+    pub fn run(
+        &mut self,
+        pts: &[[f32; 2]],
+        k: usize,
+        max_iter: usize,
+        rng: &mut Rng,
+    ) -> Result<usize> {
+        let n = pts.len();
+        if n > N {
+            return Err(Error::Capacity {
+                capacity: N,
+                requested: n,
+            });
+        }
+        let k = k.min(K).min(n).min(u16::MAX as usize);
+        if k == 0 {
+            return Ok(0);
+        }
+        for p in pts {
+            if !(p[0].is_finite() && p[1].is_finite()) {
+                return Err(Error::NonFinite);
+            }
+        }
+        // k-means++ seeding.
+        self.centres[0] = pts[(rng.below(n as u32) as usize).min(n - 1)];
+        for c in 1..k {
+            let mut total = 0.0f64;
+            for &p in pts {
+                total += self.nearest_d2(p, c) as f64;
+            }
+            let mut pick = n - 1;
+            if total > 0.0 {
+                let target = rng.uniform() as f64 * total;
+                let mut acc = 0.0f64;
+                for (i, &p) in pts.iter().enumerate() {
+                    acc += self.nearest_d2(p, c) as f64;
+                    if acc > target {
+                        pick = i;
+                        break;
+                    }
+                }
+            }
+            self.centres[c] = pts[pick];
+        }
+        for a in self.assign[..n].iter_mut() {
+            *a = u16::MAX;
+        }
+        for _ in 0..max_iter.max(1) {
+            let mut changed = false;
+            for (i, &p) in pts.iter().enumerate() {
+                let mut best = (0usize, f32::INFINITY);
+                for (c, &q) in self.centres[..k].iter().enumerate() {
+                    let d = d2(p, q);
+                    if d < best.1 {
+                        best = (c, d);
+                    }
+                }
+                if self.assign[i] as usize != best.0 {
+                    self.assign[i] = best.0 as u16;
+                    changed = true;
+                }
+            }
+            let mut sums = [[0.0f64; 2]; K];
+            self.counts = [0; K];
+            for (i, &p) in pts.iter().enumerate() {
+                let c = self.assign[i] as usize;
+                sums[c][0] += p[0] as f64;
+                sums[c][1] += p[1] as f64;
+                self.counts[c] += 1;
+            }
+            for c in 0..k {
+                if self.counts[c] > 0 {
+                    let m = self.counts[c] as f64;
+                    self.centres[c] = [(sums[c][0] / m) as f32, (sums[c][1] / m) as f32];
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        Ok(k)
+    }
+}

@@ -1,0 +1,510 @@
+//! Power observations over range x Doppler x azimuth cells (Pei et al. 2019, §1.2):
+//! cube geometry, the separable point spread (eq. 3), a stable `log I0`, and the
+//! Rician-over-exponential cell likelihood ratio (eq. 21-23, restated in the spec).
+//!
+//! Layout of a cube: `index = (i_r * n_doppler + j_d) * n_azimuth + l_b`, one `f32`
+//! power `z >= 0` per cell, borrowed by the detectors as `&[f32]`.
+
+use crate::math;
+use crate::{Error, Result};
+
+/// Degrees per radian.
+pub const DEG_PER_RAD: f32 = 180.0 / math::PI;
+
+/// Extent and resolution of the observation cube. Cell `i` on an axis spans
+/// `[start + i * size, start + (i + 1) * size)` and has its centre at `start + (i + 0.5) * size`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CubeGeometry {
+    /// Number of range cells `U_r`.
+    pub n_range: usize,
+    /// Number of Doppler cells `U_d`.
+    pub n_doppler: usize,
+    /// Number of azimuth cells `U_b`.
+    pub n_azimuth: usize,
+    /// Range of the first cell's lower edge (m).
+    pub range_start: f32,
+    /// Range cell size `R` (m).
+    pub range_cell: f32,
+    /// Radial velocity of the first Doppler cell's lower edge (m/s; positive = receding).
+    pub doppler_start: f32,
+    /// Doppler cell size `D` (m/s).
+    pub doppler_cell: f32,
+    /// Azimuth of the first cell's lower edge (deg, counter-clockwise from +x).
+    pub azimuth_start_deg: f32,
+    /// Azimuth cell size `B` (deg).
+    pub azimuth_cell_deg: f32,
+}
+
+/// A target state seen by the radar: range (m), radial velocity (m/s), azimuth (deg).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RadarCoords {
+    /// Range `r = sqrt(x^2 + y^2)`.
+    pub range: f32,
+    /// Radial velocity `d = (x vx + y vy) / r`.
+    pub doppler: f32,
+    /// Azimuth `b = atan2(y, x)` in degrees.
+    pub azimuth_deg: f32,
+}
+
+impl RadarCoords {
+    /// Radar coordinates of the CV state `[x, vx, y, vy, ..]` (radar at the origin).
+    #[inline]
+    pub fn from_state(x: f32, vx: f32, y: f32, vy: f32) -> Self {
+        let r = math::sqrt(x * x + y * y);
+        let d = if r > 1e-6 { (x * vx + y * vy) / r } else { 0.0 };
+        Self {
+            range: r,
+            doppler: d,
+            azimuth_deg: math::atan2(y, x) * DEG_PER_RAD,
+        }
+    }
+}
+
+impl CubeGeometry {
+    /// Number of cells `U_r U_d U_b`.
+    pub const fn len(&self) -> usize {
+        self.n_range * self.n_doppler * self.n_azimuth
+    }
+
+    /// True if the cube has no cells.
+    pub const fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Checks sizes and extents.
+    pub fn validate(&self) -> Result<()> {
+        if self.n_range == 0 || self.n_doppler == 0 || self.n_azimuth == 0 {
+            return Err(Error::InvalidConfig("cube dimensions must be non-zero"));
+        }
+        if self
+            .n_range
+            .checked_mul(self.n_doppler)
+            .and_then(|v| v.checked_mul(self.n_azimuth))
+            .is_none_or(|v| v > u32::MAX as usize)
+        {
+            return Err(Error::InvalidConfig("cube has more than 2^32 cells"));
+        }
+        for v in [self.range_cell, self.doppler_cell, self.azimuth_cell_deg] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::InvalidConfig("cell sizes must be positive"));
+            }
+        }
+        for v in [self.range_start, self.doppler_start, self.azimuth_start_deg] {
+            if !v.is_finite() {
+                return Err(Error::InvalidConfig("cube start values must be finite"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Linear index of cell `(i_r, j_d, l_b)`.
+    #[inline]
+    pub const fn index(&self, ir: usize, jd: usize, lb: usize) -> usize {
+        (ir * self.n_doppler + jd) * self.n_azimuth + lb
+    }
+
+    /// Inverse of [`CubeGeometry::index`].
+    #[inline]
+    pub const fn unindex(&self, idx: usize) -> (usize, usize, usize) {
+        let lb = idx % self.n_azimuth;
+        let rest = idx / self.n_azimuth;
+        (rest / self.n_doppler, rest % self.n_doppler, lb)
+    }
+
+    /// Centre of range cell `i`.
+    #[inline]
+    pub fn range_centre(&self, i: usize) -> f32 {
+        self.range_start + (i as f32 + 0.5) * self.range_cell
+    }
+    /// Centre of Doppler cell `j`.
+    #[inline]
+    pub fn doppler_centre(&self, j: usize) -> f32 {
+        self.doppler_start + (j as f32 + 0.5) * self.doppler_cell
+    }
+    /// Centre of azimuth cell `l` (deg).
+    #[inline]
+    pub fn azimuth_centre(&self, l: usize) -> f32 {
+        self.azimuth_start_deg + (l as f32 + 0.5) * self.azimuth_cell_deg
+    }
+
+    /// Fractional cell coordinates `((r - start) / size, ..)` of a radar position.
+    #[inline]
+    pub fn fractional(&self, c: &RadarCoords) -> (f32, f32, f32) {
+        (
+            (c.range - self.range_start) / self.range_cell,
+            (c.doppler - self.doppler_start) / self.doppler_cell,
+            (c.azimuth_deg - self.azimuth_start_deg) / self.azimuth_cell_deg,
+        )
+    }
+
+    /// The cell holding `c`, or `None` if it lies outside the cube (`D_i, D_j, D_l` of
+    /// eq. 25).
+    #[inline]
+    pub fn cell_of(&self, c: &RadarCoords) -> Option<(usize, usize, usize)> {
+        let (fr, fd, fb) = self.fractional(c);
+        let ok = |f: f32, n: usize| f >= 0.0 && f < n as f32;
+        if ok(fr, self.n_range) && ok(fd, self.n_doppler) && ok(fb, self.n_azimuth) {
+            Some((fr as usize, fd as usize, fb as usize))
+        } else {
+            None
+        }
+    }
+
+    /// Cartesian position `(x, y)` of the centre of range cell `ir`, azimuth cell `lb`.
+    pub fn cell_position(&self, ir: usize, lb: usize) -> (f32, f32) {
+        let r = self.range_centre(ir);
+        let b = self.azimuth_centre(lb) / DEG_PER_RAD;
+        (r * math::cos(b), r * math::sin(b))
+    }
+}
+
+/// The separable point spread of eq. 3, in cell units:
+/// `h = exp(-L_r (r_i - r)^2 / (2 R^2) - L_d (d_j - d)^2 / (2 D^2) - L_b (b_l - b)^2 / (2 B^2))`.
+///
+/// The paper writes `(r_i - r)^2 / (2R) L_r`; its loss factor is ours divided by the cell
+/// size, so `L = 1` here means a spread whose standard deviation is one cell. Only the
+/// `(2 half_width + 1)^3` cells around the target's own cell are covered (the same
+/// truncation in the simulator and in the likelihood).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointSpread {
+    /// Range loss `L_r`.
+    pub loss_range: f32,
+    /// Doppler loss `L_d`.
+    pub loss_doppler: f32,
+    /// Azimuth loss `L_b`.
+    pub loss_azimuth: f32,
+    /// Cells covered on each side of the target's cell, on every axis (0..=3).
+    pub half_width: usize,
+}
+
+/// Largest supported [`PointSpread::half_width`].
+pub const MAX_HALF_WIDTH: usize = 3;
+const MAX_SPAN: usize = 2 * MAX_HALF_WIDTH + 1;
+
+impl PointSpread {
+    /// Checks the losses and the coverage.
+    pub fn validate(&self) -> Result<()> {
+        for v in [self.loss_range, self.loss_doppler, self.loss_azimuth] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::InvalidConfig("point-spread losses must be positive"));
+            }
+        }
+        if self.half_width > MAX_HALF_WIDTH {
+            return Err(Error::InvalidConfig("point-spread half width above 3"));
+        }
+        Ok(())
+    }
+
+    /// Calls `f(index, h)` for every in-cube cell the spread of `c` covers.
+    ///
+    /// Cost: `3 (2w + 1)` exponentials and `(2w + 1)^3` products; cells outside the cube
+    /// are skipped (they contribute a likelihood ratio of 1).
+    #[inline]
+    pub fn for_each_cell(&self, g: &CubeGeometry, c: &RadarCoords, mut f: impl FnMut(usize, f32)) {
+        let (fr, fd, fb) = g.fractional(c);
+        let w = self.half_width as i64;
+        let span = 2 * self.half_width + 1;
+        let mut hr = [0.0f32; MAX_SPAN];
+        let mut hd = [0.0f32; MAX_SPAN];
+        let mut hb = [0.0f32; MAX_SPAN];
+        let mut ir = [usize::MAX; MAX_SPAN];
+        let mut jd = [usize::MAX; MAX_SPAN];
+        let mut lb = [usize::MAX; MAX_SPAN];
+        let axis = |frac: f32,
+                    n: usize,
+                    loss: f32,
+                    h: &mut [f32; MAX_SPAN],
+                    id: &mut [usize; MAX_SPAN]| {
+            if !frac.is_finite() {
+                return;
+            }
+            // Clamp so that far-away states do not overflow the i64 conversion.
+            let centre = math::floor(frac.clamp(-1.0e6, 1.0e6)) as i64;
+            for k in 0..span {
+                let i = centre - w + k as i64;
+                if i >= 0 && (i as usize) < n {
+                    let delta = i as f32 + 0.5 - frac;
+                    h[k] = math::exp(-0.5 * loss * delta * delta);
+                    id[k] = i as usize;
+                }
+            }
+        };
+        axis(fr, g.n_range, self.loss_range, &mut hr, &mut ir);
+        axis(fd, g.n_doppler, self.loss_doppler, &mut hd, &mut jd);
+        axis(fb, g.n_azimuth, self.loss_azimuth, &mut hb, &mut lb);
+        for a in 0..span {
+            if ir[a] == usize::MAX {
+                continue;
+            }
+            for b in 0..span {
+                if jd[b] == usize::MAX {
+                    continue;
+                }
+                let hab = hr[a] * hd[b];
+                let base = (ir[a] * g.n_doppler + jd[b]) * g.n_azimuth;
+                for (&l, &h) in lb[..span].iter().zip(&hb[..span]) {
+                    if l != usize::MAX {
+                        f(base + l, hab * h);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// `ln I0(x)` for `x >= 0` (modified Bessel function of the first kind, order 0), stable
+/// for every finite `x` (no overflow: `I0(x) ~ e^x / sqrt(2 pi x)`).
+///
+/// Abramowitz & Stegun 9.8.1 (`x <= 3.75`, `ln1p` of the series) and 9.8.2 (`x > 3.75`,
+/// `x - ln(x)/2 + ln(poly(3.75/x))`); relative error of `I0` below `2e-7`, so the
+/// absolute error of the log is below `~3e-7` plus `f32` rounding of `x`. Negative `x`
+/// uses `I0(-x) = I0(x)`; NaN gives NaN.
+#[allow(clippy::excessive_precision)]
+pub fn log_i0(x: f32) -> f32 {
+    let ax = if x < 0.0 { -x } else { x };
+    if ax <= 3.75 {
+        let t = (ax / 3.75) * (ax / 3.75);
+        let p = t
+            * (3.515_622_9
+                + t * (3.089_942_4
+                    + t * (1.206_749_2 + t * (0.265_973_2 + t * (0.036_076_8 + t * 0.004_581_3)))));
+        math::ln1p(p)
+    } else {
+        let t = 3.75 / ax;
+        let p = 0.398_942_28
+            + t * (0.013_285_92
+                + t * (0.002_253_19
+                    + t * (-0.001_575_65
+                        + t * (0.009_162_81
+                            + t * (-0.020_577_06
+                                + t * (0.026_355_37 + t * (-0.016_476_33 + t * 0.003_923_77)))))));
+        ax - 0.5 * math::ln(ax) + math::ln(p)
+    }
+}
+
+/// Log likelihood ratio of one cell's power `z` (Rician with amplitude `mu` over the
+/// noise-only exponential, per-component noise variance `sigma2`):
+/// `ln L(z | x) = -mu^2 / (2 sigma^2) + ln I0(mu sqrt(z) / sigma^2)` (eq. 21-23).
+#[inline]
+pub fn cell_log_lr(z: f32, mu: f32, sigma2: f32) -> f32 {
+    -mu * mu / (2.0 * sigma2) + log_i0(mu * math::sqrt(z) / sigma2)
+}
+
+/// A validated, borrowed power cube.
+#[derive(Debug, Clone, Copy)]
+pub struct PowerCube<'a> {
+    data: &'a [f32],
+    geometry: CubeGeometry,
+}
+
+impl<'a> PowerCube<'a> {
+    /// Wraps `data` after checking its length against `geometry` and that every cell is
+    /// finite and non-negative ([`Error::LengthMismatch`], [`Error::NonFinite`],
+    /// [`Error::NegativeWeight`] for a negative power).
+    pub fn new(data: &'a [f32], geometry: CubeGeometry) -> Result<Self> {
+        geometry.validate()?;
+        if data.len() != geometry.len() {
+            return Err(Error::LengthMismatch {
+                expected: geometry.len(),
+                got: data.len(),
+            });
+        }
+        let mut bad_nan = false;
+        let mut bad_neg = false;
+        for &z in data {
+            bad_nan |= !z.is_finite();
+            bad_neg |= z < 0.0;
+        }
+        if bad_nan {
+            return Err(Error::NonFinite);
+        }
+        if bad_neg {
+            return Err(Error::NegativeWeight);
+        }
+        Ok(Self { data, geometry })
+    }
+
+    /// The cells.
+    #[inline]
+    pub fn data(&self) -> &'a [f32] {
+        self.data
+    }
+
+    /// The geometry.
+    #[inline]
+    pub fn geometry(&self) -> &CubeGeometry {
+        &self.geometry
+    }
+
+    /// Like [`PowerCube::log_lr`], also returning the covered cell with the largest
+    /// factor `ln L(z | x)` (`usize::MAX` if no cell is covered).
+    #[inline]
+    pub fn log_lr_argmax(
+        &self,
+        psf: &PointSpread,
+        c: &RadarCoords,
+        amp: f32,
+        sigma2: f32,
+    ) -> (f32, usize) {
+        let mut s = 0.0f32;
+        let mut best = (usize::MAX, f32::NEG_INFINITY);
+        let data = self.data;
+        psf.for_each_cell(&self.geometry, c, |idx, h| {
+            if let Some(&z) = data.get(idx) {
+                let l = cell_log_lr(z, amp * h, sigma2);
+                s += l;
+                if l > best.1 {
+                    best = (idx, l);
+                }
+            }
+        });
+        (s, best.0)
+    }
+
+    /// `sum over covered cells of ln L(z | x)` for a target at `c` with amplitude `amp`
+    /// (the log of the product in eq. 20 and 24).
+    #[inline]
+    pub fn log_lr(&self, psf: &PointSpread, c: &RadarCoords, amp: f32, sigma2: f32) -> f32 {
+        let mut s = 0.0f32;
+        let data = self.data;
+        psf.for_each_cell(&self.geometry, c, |idx, h| {
+            if let Some(&z) = data.get(idx) {
+                s += cell_log_lr(z, amp * h, sigma2);
+            }
+        });
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// f64 reference: power series for x <= 30, asymptotic expansion above.
+    fn log_i0_ref(x: f64) -> f64 {
+        if x <= 30.0 {
+            let q = x * x / 4.0;
+            let mut term = 1.0f64;
+            let mut s = 1.0f64;
+            for k in 1..400 {
+                term *= q / ((k * k) as f64);
+                s += term;
+                if term < s * 1e-18 {
+                    break;
+                }
+            }
+            s.ln()
+        } else {
+            let mut s = 1.0f64;
+            let mut term = 1.0f64;
+            for k in 1..12 {
+                let a = (2 * k - 1) as f64;
+                term *= a * a / (k as f64 * 8.0 * x);
+                s += term;
+            }
+            x - 0.5 * (2.0 * core::f64::consts::PI * x).ln() + s.ln()
+        }
+    }
+
+    #[test]
+    fn log_i0_matches_f64_reference() {
+        // Tolerance: A&S relative error 2e-7 plus f32 rounding of x - ln x/2 (relative
+        // 6e-8 of a value up to ~1e4).
+        let mut x = 0.0f64;
+        while x < 1.0e4 {
+            let got = log_i0(x as f32) as f64;
+            let want = log_i0_ref(x as f32 as f64);
+            let tol = 1e-6 + 2e-7 * want.abs();
+            assert!((got - want).abs() <= tol, "x={x} got={got} want={want}");
+            x = if x < 10.0 { x + 0.01 } else { x * 1.01 };
+        }
+        assert!(log_i0(1.0e30).is_finite());
+        assert_eq!(log_i0(-2.0), log_i0(2.0));
+    }
+
+    #[test]
+    fn likelihood_ratio_is_one_without_target() {
+        assert_eq!(cell_log_lr(3.0, 0.0, 1.0), 0.0);
+    }
+
+    fn geom() -> CubeGeometry {
+        CubeGeometry {
+            n_range: 10,
+            n_doppler: 6,
+            n_azimuth: 8,
+            range_start: 0.0,
+            range_cell: 20.0,
+            doppler_start: -3.0,
+            doppler_cell: 1.0,
+            azimuth_start_deg: 0.0,
+            azimuth_cell_deg: 1.0,
+        }
+    }
+
+    #[test]
+    fn index_roundtrip_and_cube_checks() {
+        let g = geom();
+        for idx in 0..g.len() {
+            let (a, b, c) = g.unindex(idx);
+            assert_eq!(g.index(a, b, c), idx);
+        }
+        let mut v = std::vec![1.0f32; g.len()];
+        assert!(PowerCube::new(&v, g).is_ok());
+        assert_eq!(
+            PowerCube::new(&v[1..], g).err(),
+            Some(Error::LengthMismatch {
+                expected: g.len(),
+                got: g.len() - 1
+            })
+        );
+        v[7] = f32::NAN;
+        assert_eq!(PowerCube::new(&v, g).err(), Some(Error::NonFinite));
+        v[7] = -1.0;
+        assert_eq!(PowerCube::new(&v, g).err(), Some(Error::NegativeWeight));
+    }
+
+    #[test]
+    fn spread_covers_neighbourhood_and_peaks_at_own_cell() {
+        let g = geom();
+        let psf = PointSpread {
+            loss_range: 1.0,
+            loss_doppler: 1.0,
+            loss_azimuth: 1.0,
+            half_width: 1,
+        };
+        let c = RadarCoords {
+            range: 90.0,
+            doppler: 0.5,
+            azimuth_deg: 3.5,
+        };
+        let own = g.cell_of(&c).map(|(a, b, l)| g.index(a, b, l));
+        let mut n = 0;
+        let mut best = (0usize, 0.0f32);
+        psf.for_each_cell(&g, &c, |i, h| {
+            n += 1;
+            if h > best.1 {
+                best = (i, h);
+            }
+        });
+        assert_eq!(n, 27);
+        assert_eq!(Some(best.0), own);
+        // At a corner only 8 cells are inside the cube.
+        let corner = RadarCoords {
+            range: 1.0,
+            doppler: -2.9,
+            azimuth_deg: 0.2,
+        };
+        let mut m = 0;
+        psf.for_each_cell(&g, &corner, |_, _| m += 1);
+        assert_eq!(m, 8);
+        // Far outside: nothing, no panic.
+        let mut k = 0;
+        let far = RadarCoords {
+            range: f32::INFINITY,
+            doppler: f32::NAN,
+            azimuth_deg: 1e30,
+        };
+        psf.for_each_cell(&g, &far, |_, _| k += 1);
+        assert_eq!(k, 0);
+    }
+}

@@ -1,0 +1,212 @@
+//! PSO-PHD-TBD building blocks against brute-force references: grid DBSCAN versus the
+//! O(N^2) textbook DBSCAN, ENS-BS non-dominated sorting versus O(N^2) peeling.
+
+use faint::core::detect::phd::dbscan::{Dbscan, DbscanParams, NOISE};
+use faint::core::detect::phd::pso::{crowding_distance, dominates, non_dominated_sort};
+use faint::core::rng::Rng;
+
+/// Textbook DBSCAN: neighbour lists by all-pairs scan.
+fn brute_dbscan(p: &[[f32; 2]], eps: f32, min_pts: usize) -> (Vec<bool>, Vec<i32>) {
+    let n = p.len();
+    let e2 = eps * eps;
+    let nb: Vec<Vec<usize>> = (0..n)
+        .map(|i| {
+            (0..n)
+                .filter(|&j| {
+                    let (dx, dy) = (p[i][0] - p[j][0], p[i][1] - p[j][1]);
+                    dx * dx + dy * dy <= e2
+                })
+                .collect()
+        })
+        .collect();
+    let core: Vec<bool> = nb.iter().map(|v| v.len() >= min_pts).collect();
+    let mut lab = vec![-2i32; n];
+    let mut c = 0;
+    for i in 0..n {
+        if lab[i] != -2 {
+            continue;
+        }
+        if !core[i] {
+            lab[i] = -1;
+            continue;
+        }
+        lab[i] = c;
+        let mut st = vec![i];
+        while let Some(q) = st.pop() {
+            if !core[q] {
+                continue;
+            }
+            for &o in &nb[q] {
+                if lab[o] < 0 {
+                    lab[o] = c;
+                    st.push(o);
+                }
+            }
+        }
+        c += 1;
+    }
+    (core, lab)
+}
+
+fn random_points(rng: &mut Rng, n: usize) -> Vec<[f32; 2]> {
+    // Blobs of varying spread plus uniform background, on a coarse lattice sometimes so
+    // that exact ties and duplicates occur.
+    let blobs = 1 + rng.below(6) as usize;
+    let centres: Vec<[f32; 2]> = (0..blobs)
+        .map(|_| [rng.uniform_range(0.0, 200.0), rng.uniform_range(0.0, 200.0)])
+        .collect();
+    let lattice = rng.bernoulli(0.3);
+    (0..n)
+        .map(|_| {
+            let mut p = if rng.bernoulli(0.2) {
+                [rng.uniform_range(0.0, 200.0), rng.uniform_range(0.0, 200.0)]
+            } else {
+                let c = centres[rng.below(blobs as u32) as usize];
+                let s = rng.uniform_range(0.5, 8.0);
+                [c[0] + s * rng.normal(), c[1] + s * rng.normal()]
+            };
+            if lattice {
+                p = [(p[0]).round(), (p[1]).round()];
+            }
+            p
+        })
+        .collect()
+}
+
+#[test]
+fn grid_dbscan_matches_brute_force() {
+    let mut rng = Rng::seed_from_u64(2024);
+    let mut db = Box::new(Dbscan::<2048>::new());
+    for case in 0..300 {
+        let n = 1 + rng.below(1500) as usize;
+        let pts = random_points(&mut rng, n);
+        let eps = rng.uniform_range(0.5, 8.0);
+        let min_pts = 1 + rng.below(15) as usize;
+        let (core, lab) = brute_dbscan(&pts, eps, min_pts);
+        let mut sizes = Vec::new();
+        let k = db
+            .run(&pts, &DbscanParams { eps, min_pts }, |m| {
+                sizes.push(m.len())
+            })
+            .unwrap();
+        let got = &db.labels[..n];
+        let nclus = lab.iter().copied().max().map_or(0, |m| m + 1) as usize;
+        assert_eq!(k, nclus, "case {case}: cluster count");
+        assert_eq!(
+            sizes.iter().sum::<usize>(),
+            got.iter().filter(|&&l| l >= 0).count()
+        );
+        // Same noise points.
+        for i in 0..n {
+            assert_eq!(
+                got[i] == NOISE,
+                lab[i] == -1,
+                "case {case}: noise point {i}"
+            );
+        }
+        // Same partition of core points (labels may be permuted).
+        let mut map = vec![-1i32; nclus];
+        for i in 0..n {
+            if core[i] {
+                let b = lab[i] as usize;
+                if map[b] < 0 {
+                    map[b] = got[i];
+                }
+                assert_eq!(map[b], got[i], "case {case}: core point {i}");
+            }
+        }
+        // Border points belong to a cluster with a core point within eps.
+        for i in 0..n {
+            if !core[i] && got[i] >= 0 {
+                let ok = (0..n).any(|j| {
+                    core[j] && got[j] == got[i] && {
+                        let (dx, dy) = (pts[i][0] - pts[j][0], pts[i][1] - pts[j][1]);
+                        dx * dx + dy * dy <= eps * eps
+                    }
+                });
+                assert!(ok, "case {case}: border point {i}");
+            }
+        }
+    }
+}
+
+#[test]
+fn dbscan_rejects_bad_input() {
+    let mut db = Box::new(Dbscan::<16>::new());
+    let p = DbscanParams {
+        eps: 1.0,
+        min_pts: 2,
+    };
+    assert!(db.run(&[[0.0, f32::NAN]], &p, |_| {}).is_err());
+    assert!(db.run(&[[0.0, 0.0]; 17], &p, |_| {}).is_err());
+    assert!(db
+        .run(
+            &[[0.0, 0.0]],
+            &DbscanParams {
+                eps: 0.0,
+                min_pts: 2
+            },
+            |_| {}
+        )
+        .is_err());
+    assert_eq!(db.run(&[], &p, |_| {}).unwrap(), 0);
+}
+
+/// Reference ranks by repeated peeling of the non-dominated set.
+fn brute_ranks(f: &[[f32; 4]], m: usize) -> Vec<u32> {
+    let n = f.len();
+    let mut rank = vec![u32::MAX; n];
+    let mut r = 0;
+    while rank.contains(&u32::MAX) {
+        let cur: Vec<usize> = (0..n)
+            .filter(|&i| {
+                rank[i] == u32::MAX
+                    && !(0..n).any(|j| rank[j] == u32::MAX && dominates(&f[j][..m], &f[i][..m]))
+            })
+            .collect();
+        for i in cur {
+            rank[i] = r;
+        }
+        r += 1;
+    }
+    rank
+}
+
+#[test]
+fn ens_bs_sort_matches_brute_force_ranking() {
+    let mut rng = Rng::seed_from_u64(77);
+    for case in 0..400 {
+        let n = 1 + rng.below(300) as usize;
+        let m = 1 + rng.below(4) as usize;
+        let levels = if rng.bernoulli(0.5) { 4.0 } else { 1000.0 };
+        let f: Vec<[f32; 4]> = (0..n)
+            .map(|_| {
+                let mut v = [0.0f32; 4];
+                for x in v.iter_mut() {
+                    *x = (rng.uniform() * levels).floor() / levels;
+                }
+                v
+            })
+            .collect();
+        let (mut rank, mut order, mut next, mut head) =
+            (vec![0u32; n], vec![0u32; n], vec![0u32; n], vec![0u32; n]);
+        let fronts = non_dominated_sort(&f, m, &mut rank, &mut order, &mut next, &mut head);
+        let want = brute_ranks(&f, m);
+        assert_eq!(rank, want, "case {case} (n={n}, m={m})");
+        assert_eq!(fronts as u32, want.iter().max().unwrap() + 1);
+    }
+}
+
+#[test]
+fn crowding_gives_boundaries_the_maximum_and_inner_points_the_weighted_gap() {
+    // One front, one objective: points 0, 1, 3, 6 -> inner gaps (3-0)/6, (6-1)/6.
+    let f = [[0.0f32], [1.0], [3.0], [6.0]];
+    let rank = [0u32; 4];
+    let mut crowd = [0.0f32; 4];
+    let mut order = [0u32; 4];
+    crowding_distance(&f, 1, &[2.0], &rank, 1e9, &mut crowd, &mut order);
+    assert_eq!(crowd[0], 1e9);
+    assert_eq!(crowd[3], 1e9);
+    assert!((crowd[1] - 2.0 * 3.0 / 6.0).abs() < 1e-6);
+    assert!((crowd[2] - 2.0 * 5.0 / 6.0).abs() < 1e-6);
+}
