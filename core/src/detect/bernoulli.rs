@@ -19,7 +19,7 @@ use crate::math;
 use crate::model::doppler::{check_frame, FrameDetector, Model, TbdReport};
 use crate::particles::{gather_in_place, resample, Scheme};
 use crate::rng::Rng;
-use crate::{Complex32, Error, Result};
+use crate::{Complex32, Result};
 
 /// Bernoulli (JOTT) filter with `N` particles.
 #[derive(Debug, Clone)]
@@ -41,11 +41,7 @@ impl<const N: usize> BernoulliTbd<N> {
     /// without building a detector by value: how one that lives in a `static` (e.g. the
     /// firmware's zero-initialised ones) is set up. On error `self` is unchanged.
     pub fn reconfigure(&mut self, cfg: GaussConfig, seed: u64) -> Result<()> {
-        if N == 0 {
-            return Err(Error::InvalidConfig("particle count N = 0"));
-        }
-        let model = cfg.validate()?;
-        let inv_var = check_variance(cfg.noise_var)?;
+        let (model, inv_var) = cfg.prepare::<N>()?;
         self.cfg = cfg;
         self.model = model;
         self.inv_var = inv_var;
@@ -55,11 +51,7 @@ impl<const N: usize> BernoulliTbd<N> {
 
     /// Validates `cfg`; `q_0 = initial_existence`, particles from `U(I_x0)`.
     pub fn new(cfg: GaussConfig, seed: u64) -> Result<Self> {
-        if N == 0 {
-            return Err(Error::InvalidConfig("particle count N = 0"));
-        }
-        let model = cfg.validate()?;
-        let inv_var = check_variance(cfg.noise_var)?;
+        let (model, inv_var) = cfg.prepare::<N>()?;
         let mut s = Self {
             cfg,
             model,

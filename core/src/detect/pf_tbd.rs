@@ -43,6 +43,16 @@ impl GaussConfig {
         check_variance(self.noise_var)?;
         self.model.build()
     }
+
+    /// What every Gaussian comparator's `new` / `reconfigure` needs: `N > 0`, the built
+    /// model and `1 / s2`.
+    pub(crate) fn prepare<const N: usize>(&self) -> Result<(Model, f32)> {
+        if N == 0 {
+            return Err(Error::InvalidConfig("particle count N = 0"));
+        }
+        let model = self.validate()?;
+        Ok((model, 1.0 / self.noise_var))
+    }
 }
 
 pub(crate) fn check_variance(v: f32) -> Result<f32> {
@@ -122,11 +132,7 @@ impl<const N: usize> PfTbd<N> {
     /// without building a detector by value: how one that lives in a `static` (e.g. the
     /// firmware's zero-initialised ones) is set up. On error `self` is unchanged.
     pub fn reconfigure(&mut self, cfg: GaussConfig, seed: u64) -> Result<()> {
-        if N == 0 {
-            return Err(Error::InvalidConfig("particle count N = 0"));
-        }
-        let model = cfg.validate()?;
-        let inv_var = check_variance(cfg.noise_var)?;
+        let (model, inv_var) = cfg.prepare::<N>()?;
         self.cfg = cfg;
         self.model = model;
         self.inv_var = inv_var;
@@ -136,11 +142,7 @@ impl<const N: usize> PfTbd<N> {
 
     /// Validates `cfg` and draws the initial particles (`E_0 ~ Bernoulli`, `x ~ U(I_x0)`).
     pub fn new(cfg: GaussConfig, seed: u64) -> Result<Self> {
-        if N == 0 {
-            return Err(Error::InvalidConfig("particle count N = 0"));
-        }
-        let model = cfg.validate()?;
-        let inv_var = check_variance(cfg.noise_var)?;
+        let (model, inv_var) = cfg.prepare::<N>()?;
         let mut s = Self {
             cfg,
             model,
