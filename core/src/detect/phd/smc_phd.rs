@@ -25,7 +25,9 @@ use super::dbscan::{Dbscan, DbscanParams};
 use super::kmeans::KMeans;
 use super::pso::{PsoConfig, Swarm};
 use crate::math::{self, KahanSum};
-use crate::model::power_cube::{CubeGeometry, PointSpread, PowerCube, RadarCoords, DEG_PER_RAD};
+use crate::model::power_cube::{
+    AxisWeights, CubeGeometry, PointSpread, PowerCube, RadarCoords, DEG_PER_RAD,
+};
 use crate::particles::{resample, Scheme};
 use crate::rng::Rng;
 use crate::{Error, Result};
@@ -579,19 +581,39 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         );
         let data = cube.data();
         let mut n = 0usize;
+        // The spread of a target at a cell centre, one axis at a time (each axis depends
+        // on one cell index only, so it is computed once per grid line, not per cell;
+        // bit-identical to `for_each_cell` at the centre). Azimuth weights are cached
+        // for windows up to `AZ_CACHE` cells wide.
+        const AZ_CACHE: usize = 16;
+        let frac = |ir: usize, jd: usize, lb: usize| {
+            g.fractional(&RadarCoords {
+                range: g.range_centre(ir),
+                doppler: g.doppler_centre(jd),
+                azimuth_deg: g.azimuth_centre(lb),
+            })
+        };
+        let mut az = [AxisWeights::NONE; AZ_CACHE];
+        let cached = b1.saturating_sub(b0) <= AZ_CACHE;
+        if cached {
+            for lb in b0..b1 {
+                az[lb - b0] = psf.axis_weights(frac(0, 0, lb).2, g.n_azimuth, psf.loss_azimuth);
+            }
+        }
         for ir in r0..r1 {
+            let wr = psf.axis_weights(frac(ir, 0, 0).0, g.n_range, psf.loss_range);
             for jd in 0..g.n_doppler {
+                let wd = psf.axis_weights(frac(0, jd, 0).1, g.n_doppler, psf.loss_doppler);
                 for lb in b0..b1 {
                     let idx = g.index(ir, jd, lb);
                     // Point-spread-matched statistic `sum h^2 z` of a target at the cell
                     // centre, as for the swarm's points.
-                    let centre = RadarCoords {
-                        range: g.range_centre(ir),
-                        doppler: g.doppler_centre(jd),
-                        azimuth_deg: g.azimuth_centre(lb),
+                    let wb = match az.get(lb - b0) {
+                        Some(w) if cached => *w,
+                        _ => psf.axis_weights(frac(0, 0, lb).2, g.n_azimuth, psf.loss_azimuth),
                     };
                     let mut z = 0.0f32;
-                    psf.for_each_cell(g, &centre, |i, h| {
+                    psf.for_each_cell_of(g, &wr, &wd, &wb, |i, h| {
                         if let Some(&v) = data.get(i) {
                             z += h * h * v;
                         }
