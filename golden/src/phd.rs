@@ -17,7 +17,7 @@
 //!
 //! The golden case uses the [`GOLDEN_WINDOW`] (16 x 16 x 16 cells) and a small filter
 //! (`SmcPhdTbd<256, 256, 4, 4>`, 60 particles per target, 64 births) that lives on the
-//! stack: stack use is about 60 KiB (filter ~46 KiB, cube 16 KiB).
+//! stack: stack use is about 70 KiB (filter ~50 KiB, cube 16 KiB).
 
 use faint_core::detect::phd::{
     BirthComponent, BirthMode, BirthModel, Config, DbscanParams, Extractor, PsoConfig, SmcPhdTbd,
