@@ -16,6 +16,7 @@ use cortex_m_semihosting::hprintln;
 mod crpf;
 mod harness;
 mod mht;
+mod phd;
 mod primitives;
 
 #[entry]
@@ -30,6 +31,7 @@ fn main() -> ! {
     // Detectors: one `<name>::run();` line each, here.
     mht::run();
     crpf::run();
+    phd::run();
     hprintln!();
     hprintln!(
         "static RAM of this image (.data + .bss, all rows): {} bytes",

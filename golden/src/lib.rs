@@ -33,6 +33,7 @@
 use core::fmt;
 
 pub mod crpf;
+pub mod phd;
 
 use faint_core::existence::ExistenceMarkov;
 use faint_core::math;
@@ -101,6 +102,7 @@ pub fn cases(emit: &mut dyn FnMut(&str, &[u32])) {
     existence_cases(emit);
     mht::cases(emit);
     crpf::cases(emit);
+    phd::cases(emit);
 }
 
 fn bits<const K: usize>(mut f: impl FnMut() -> f32) -> [u32; K] {

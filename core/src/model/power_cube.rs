@@ -200,49 +200,64 @@ impl PointSpread {
     /// Cost: `3 (2w + 1)` exponentials and `(2w + 1)^3` products; cells outside the cube
     /// are skipped (they contribute a likelihood ratio of 1).
     #[inline]
-    pub fn for_each_cell(&self, g: &CubeGeometry, c: &RadarCoords, mut f: impl FnMut(usize, f32)) {
+    pub fn for_each_cell(&self, g: &CubeGeometry, c: &RadarCoords, f: impl FnMut(usize, f32)) {
         let (fr, fd, fb) = g.fractional(c);
-        let w = self.half_width as i64;
-        let span = 2 * self.half_width + 1;
-        let mut hr = [0.0f32; MAX_SPAN];
-        let mut hd = [0.0f32; MAX_SPAN];
-        let mut hb = [0.0f32; MAX_SPAN];
-        let mut ir = [usize::MAX; MAX_SPAN];
-        let mut jd = [usize::MAX; MAX_SPAN];
-        let mut lb = [usize::MAX; MAX_SPAN];
-        let axis = |frac: f32,
-                    n: usize,
-                    loss: f32,
-                    h: &mut [f32; MAX_SPAN],
-                    id: &mut [usize; MAX_SPAN]| {
-            if !frac.is_finite() {
-                return;
+        let r = self.axis_weights(fr, g.n_range, self.loss_range);
+        let d = self.axis_weights(fd, g.n_doppler, self.loss_doppler);
+        let b = self.axis_weights(fb, g.n_azimuth, self.loss_azimuth);
+        self.for_each_cell_of(g, &r, &d, &b, f);
+    }
+
+    /// One axis of [`PointSpread::for_each_cell`]: the covered cells and weights
+    /// `exp(-L delta^2 / 2)` around the fractional cell coordinate `frac` (a component of
+    /// [`CubeGeometry::fractional`]) on an axis of `n` cells with loss `loss`. Callers that
+    /// scan a grid of positions compute each axis once per grid line and combine them with
+    /// [`PointSpread::for_each_cell_of`] (bit-identical to `for_each_cell`).
+    #[inline]
+    pub fn axis_weights(&self, frac: f32, n: usize, loss: f32) -> AxisWeights {
+        let mut a = AxisWeights::NONE;
+        if !frac.is_finite() {
+            return a;
+        }
+        let w = self.half_width.min(MAX_HALF_WIDTH) as i64;
+        let span = 2 * w as usize + 1;
+        // Clamp so that far-away states do not overflow the i64 conversion.
+        let centre = math::floor(frac.clamp(-1.0e6, 1.0e6)) as i64;
+        for k in 0..span {
+            let i = centre - w + k as i64;
+            if i >= 0 && (i as usize) < n {
+                let delta = i as f32 + 0.5 - frac;
+                a.h[k] = math::exp(-0.5 * loss * delta * delta);
+                a.id[k] = i as usize;
             }
-            // Clamp so that far-away states do not overflow the i64 conversion.
-            let centre = math::floor(frac.clamp(-1.0e6, 1.0e6)) as i64;
-            for k in 0..span {
-                let i = centre - w + k as i64;
-                if i >= 0 && (i as usize) < n {
-                    let delta = i as f32 + 0.5 - frac;
-                    h[k] = math::exp(-0.5 * loss * delta * delta);
-                    id[k] = i as usize;
-                }
-            }
-        };
-        axis(fr, g.n_range, self.loss_range, &mut hr, &mut ir);
-        axis(fd, g.n_doppler, self.loss_doppler, &mut hd, &mut jd);
-        axis(fb, g.n_azimuth, self.loss_azimuth, &mut hb, &mut lb);
+        }
+        a
+    }
+
+    /// Calls `f(index, h)` for the cells of the product of three axes' weights (range,
+    /// Doppler, azimuth), in the order and with the products of
+    /// [`PointSpread::for_each_cell`].
+    #[inline]
+    pub fn for_each_cell_of(
+        &self,
+        g: &CubeGeometry,
+        r: &AxisWeights,
+        d: &AxisWeights,
+        b: &AxisWeights,
+        mut f: impl FnMut(usize, f32),
+    ) {
+        let span = 2 * self.half_width.min(MAX_HALF_WIDTH) + 1;
         for a in 0..span {
-            if ir[a] == usize::MAX {
+            if r.id[a] == usize::MAX {
                 continue;
             }
-            for b in 0..span {
-                if jd[b] == usize::MAX {
+            for k in 0..span {
+                if d.id[k] == usize::MAX {
                     continue;
                 }
-                let hab = hr[a] * hd[b];
-                let base = (ir[a] * g.n_doppler + jd[b]) * g.n_azimuth;
-                for (&l, &h) in lb[..span].iter().zip(&hb[..span]) {
+                let hab = r.h[a] * d.h[k];
+                let base = (r.id[a] * g.n_doppler + d.id[k]) * g.n_azimuth;
+                for (&l, &h) in b.id[..span].iter().zip(&b.h[..span]) {
                     if l != usize::MAX {
                         f(base + l, hab * h);
                     }
@@ -250,6 +265,23 @@ impl PointSpread {
             }
         }
     }
+}
+
+/// Covered cells and weights of one axis of a [`PointSpread`] (see
+/// [`PointSpread::axis_weights`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AxisWeights {
+    h: [f32; MAX_SPAN],
+    /// Cell index per slot, `usize::MAX` outside the axis.
+    id: [usize; MAX_SPAN],
+}
+
+impl AxisWeights {
+    /// No covered cell.
+    pub const NONE: Self = Self {
+        h: [0.0; MAX_SPAN],
+        id: [usize::MAX; MAX_SPAN],
+    };
 }
 
 /// `ln I0(x)` for `x >= 0` (modified Bessel function of the first kind, order 0), stable

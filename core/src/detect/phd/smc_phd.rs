@@ -25,7 +25,9 @@ use super::dbscan::{Dbscan, DbscanParams};
 use super::kmeans::KMeans;
 use super::pso::{PsoConfig, Swarm};
 use crate::math::{self, KahanSum};
-use crate::model::power_cube::{CubeGeometry, PointSpread, PowerCube, RadarCoords, DEG_PER_RAD};
+use crate::model::power_cube::{
+    AxisWeights, CubeGeometry, PointSpread, PowerCube, RadarCoords, DEG_PER_RAD,
+};
 use crate::particles::{resample, Scheme};
 use crate::rng::Rng;
 use crate::{Error, Result};
@@ -237,6 +239,10 @@ pub struct Report {
 /// The SMC-PHD TBD filter with capacities: `N` particles (survivors plus births), `S`
 /// swarm entries (parents plus children, so up to `S / 2` particles move), `M`
 /// measurement points (PSO objectives), `K` extracted targets.
+///
+/// Memory: about `123 N + (56 + 4 M) S` bytes (32-bit target; e.g. 864 KB at
+/// `N = S = 4096, M = 8`): build large instances in a `Box`, or zeroed in a `static` and
+/// set up by [`SmcPhdTbd::reconfigure`].
 #[derive(Debug, Clone)]
 pub struct SmcPhdTbd<const N: usize, const S: usize, const M: usize, const K: usize> {
     cfg: Config,
@@ -353,10 +359,22 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         Ok(())
     }
 
+    /// Re-validates `cfg` and restarts in place from `seed`, behaving exactly as
+    /// [`new`](Self::new)`(cfg, seed)` would, without building the (large) filter by
+    /// value: how one that lives in a `static` is set up, including from the all-zero
+    /// value (e.g. the firmware's `.bss` detectors). On error `self` is unchanged.
+    pub fn reconfigure(&mut self, cfg: Config, seed: u64) -> Result<()> {
+        Self::check(&cfg)?;
+        self.cfg = cfg;
+        self.reset(seed);
+        Ok(())
+    }
+
     /// Empties the PHD and reseeds (same configuration).
     pub fn reset(&mut self, seed: u64) {
         self.n = 0;
         self.n_est = 0;
+        self.n_z = 0;
         self.rng = Rng::seed_from_u64(seed);
         self.birth_nb = [0; MAX_BIRTH_COMPONENTS];
     }
@@ -563,19 +581,39 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         );
         let data = cube.data();
         let mut n = 0usize;
+        // The spread of a target at a cell centre, one axis at a time (each axis depends
+        // on one cell index only, so it is computed once per grid line, not per cell;
+        // bit-identical to `for_each_cell` at the centre). Azimuth weights are cached
+        // for windows up to `AZ_CACHE` cells wide.
+        const AZ_CACHE: usize = 16;
+        let frac = |ir: usize, jd: usize, lb: usize| {
+            g.fractional(&RadarCoords {
+                range: g.range_centre(ir),
+                doppler: g.doppler_centre(jd),
+                azimuth_deg: g.azimuth_centre(lb),
+            })
+        };
+        let mut az = [AxisWeights::NONE; AZ_CACHE];
+        let cached = b1.saturating_sub(b0) <= AZ_CACHE;
+        if cached {
+            for lb in b0..b1 {
+                az[lb - b0] = psf.axis_weights(frac(0, 0, lb).2, g.n_azimuth, psf.loss_azimuth);
+            }
+        }
         for ir in r0..r1 {
+            let wr = psf.axis_weights(frac(ir, 0, 0).0, g.n_range, psf.loss_range);
             for jd in 0..g.n_doppler {
+                let wd = psf.axis_weights(frac(0, jd, 0).1, g.n_doppler, psf.loss_doppler);
                 for lb in b0..b1 {
                     let idx = g.index(ir, jd, lb);
                     // Point-spread-matched statistic `sum h^2 z` of a target at the cell
                     // centre, as for the swarm's points.
-                    let centre = RadarCoords {
-                        range: g.range_centre(ir),
-                        doppler: g.doppler_centre(jd),
-                        azimuth_deg: g.azimuth_centre(lb),
+                    let wb = match az.get(lb - b0) {
+                        Some(w) if cached => *w,
+                        _ => psf.axis_weights(frac(0, 0, lb).2, g.n_azimuth, psf.loss_azimuth),
                     };
                     let mut z = 0.0f32;
-                    psf.for_each_cell(g, &centre, |i, h| {
+                    psf.for_each_cell_of(g, &wr, &wd, &wb, |i, h| {
                         if let Some(&v) = data.get(i) {
                             z += h * h * v;
                         }
