@@ -1,20 +1,122 @@
 //! Clutter-only diagnostics of MHT-TBD at one lambda: DMHT cell size, the law of a cell's
 //! count over all cells against the model's `P0` (eq. 25), and the make-up of each
-//! period's largest cell (scans hit, runs of consecutive scans).
+//! period's largest cell (scans hit, runs of consecutive scans); the paper's law (eq.
+//! 20-26) and the compound law side by side.
 //! `cargo run --release --example mht_diag -- LAMBDA TRIALS`
+//!
+//! False tracks with targets present (item 4 of the README's MHT-TBD section):
+//! `cargo run --release --example mht_diag -- fa LAMBDA TRIALS [GAMMA1]` runs the scene with
+//! its 5 targets at the default model's `gamma_1` (or `GAMMA1`), and prints for every
+//! confirmed track matching no target: its peak's raw count, plots (effective, look-back),
+//! the plots that belong to targets and to other confirmed tracks, and the peak cell's
+//! count without the plots of the other confirmed tracks.
 use faint_core::rng::Rng;
-use faint_host::analysis::hough_model::CellModel;
-use faint_host::reproduce::mht::{detectors, model_params, NR, NT};
-use faint_host::scenario::sea_clutter::SeaClutter;
+use faint_host::analysis::hough_model::{CellModel, ChainSource, CompoundModel};
+use faint_host::reproduce::mht::{detectors, model_params, thresholds, MATCH_TOL, NR, NT};
+use faint_host::scenario::sea_clutter::{Origin, SeaClutter};
+
+fn false_tracks(a: &[String]) {
+    let lambda: f32 = a.get(2).and_then(|s| s.parse().ok()).unwrap_or(164.0);
+    let trials: u64 = a.get(3).and_then(|s| s.parse().ok()).unwrap_or(200);
+    let sc = SeaClutter::paper(lambda);
+    let g1 = a
+        .get(4)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| thresholds(&sc, 1e-4).0 as u8);
+    let n = sc.n_scans;
+    let (mut nfa, mut n_resid_below) = (0usize, 0usize);
+    println!("lambda {lambda} trials {trials} gamma_1 {g1}");
+    println!("trial raw n_plots n_eff lookback target_plots(own max) in_other_tracks resid_count");
+    for t in 0..trials {
+        let mut rng = Rng::from_stream(4242, t);
+        let tr = sc.generate(&mut rng);
+        let Ok((mut m, _)) = detectors(&sc, g1, n as u8) else {
+            return;
+        };
+        for s in &tr.scans {
+            let _ = m.step(&s.plots);
+        }
+        let tracks = m.tracks();
+        let g = *m.dmht_geometry();
+        for (ti, trk) in tracks.iter().enumerate() {
+            let (co, si) = (trk.theta.cos(), trk.theta.sin());
+            let mut per_target = vec![0usize; tr.targets.len()];
+            for s in 0..n {
+                let k = trk.plots[s];
+                if k != u16::MAX {
+                    if let Origin::Target(i) = tr.scans[s].origin[usize::from(k)] {
+                        per_target[i] += 1;
+                    }
+                }
+            }
+            let matched = (0..tr.targets.len()).any(|i| {
+                (0..n).all(|s| {
+                    let (x, y) = tr.targets[i].position(s as f32 * sc.t_scan);
+                    (x * co + y * si - trk.c).abs() <= MATCH_TOL
+                }) || 2 * per_target[i] > usize::from(trk.n_plots)
+            });
+            if matched {
+                continue;
+            }
+            nfa += 1;
+            let in_other = (0..n)
+                .filter(|&s| {
+                    trk.plots[s] != u16::MAX
+                        && tracks
+                            .iter()
+                            .enumerate()
+                            .any(|(oi, o)| oi != ti && o.plots[s] == trk.plots[s])
+                })
+                .count();
+            // peak cell count without the plots of the other confirmed tracks
+            let (r, aa) = (usize::from(trk.peak.r), usize::from(trk.peak.a));
+            let resid = (0..n)
+                .filter(|&s| {
+                    tr.scans[s].plots.iter().enumerate().any(|(k, p)| {
+                        m.is_effective(s, k)
+                            && g.rho_index_f32(p.x, p.y, aa) == r
+                            && !tracks
+                                .iter()
+                                .enumerate()
+                                .any(|(oi, o)| oi != ti && usize::from(o.plots[s]) == k)
+                    })
+                })
+                .count();
+            if resid < usize::from(g1) {
+                n_resid_below += 1;
+            }
+            println!(
+                "{t:>5} {:>3} {:>7} {:>5} {:>8} {:>3} ({:>2}) {:>15} {:>11}",
+                trk.peak.raw,
+                trk.n_plots,
+                trk.n_effective,
+                trk.lookback.count_ones(),
+                per_target.iter().sum::<usize>(),
+                per_target.iter().max().copied().unwrap_or(0),
+                in_other,
+                resid
+            );
+        }
+    }
+    println!(
+        "false tracks {nfa} in {trials} trials; with the other tracks' plots removed, {n_resid_below} of them fall below gamma_1"
+    );
+}
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
+    if a.get(1).map(String::as_str) == Some("fa") {
+        false_tracks(&a);
+        return;
+    }
     let lambda: f32 = a.get(1).and_then(|s| s.parse().ok()).unwrap_or(164.0);
     let trials: u64 = a.get(2).and_then(|s| s.parse().ok()).unwrap_or(100);
     let mut sc = SeaClutter::paper(lambda);
     sc.n_targets = 0;
     let n = sc.n_scans;
     let cm = CellModel::new(model_params(&sc));
+    let cn = CompoundModel::new(model_params(&sc), ChainSource::PaperNc);
+    let cp = CompoundModel::new(model_params(&sc), ChainSource::Censoring);
     let mut hist = vec![0u64; n + 1];
     let (mut drho_sum, mut eff_sum) = (0.0f64, 0u64);
     let mut max_hist = vec![0u64; n + 1];
@@ -83,7 +185,25 @@ fn main() {
         cm.n_c,
         cm.p0_cross
     );
-    println!("gamma  sim_cell_tail  model_cell_tail  sim_grid(max>=g)  model_grid");
+    println!(
+        "compound: chains {:.1} -> {:.2} effective plots/scan (with N_c: {} -> {:.2}), drho {:.2} cells",
+        cp.chains,
+        cp.clutter_per_scan(),
+        cn.chains,
+        cn.clutter_per_scan(),
+        cp.drho
+    );
+    let mut sc5 = sc;
+    sc5.n_targets = 5;
+    println!(
+        "gamma_1 for grid Pfa 1e-4: paper N_t=5 {}, N_t=0 {}; compound N_t=0 {}, N_t=5 {}; compound with N_c, N_t=0 {}",
+        CellModel::new(model_params(&sc5)).gamma_for_pfa(1e-4),
+        cm.gamma_for_pfa(1e-4),
+        cp.gamma_for_pfa(1e-4),
+        CompoundModel::new(model_params(&sc5), ChainSource::Censoring).gamma_for_pfa(1e-4),
+        cn.gamma_for_pfa(1e-4)
+    );
+    println!("gamma  sim_cell_tail  paper_cell_tail  compound_cell_tail  cmp_Nc_cell_tail  sim_grid(max>=g)  paper_grid  compound_grid  cmp_Nc_grid");
     let mut tail = 0u64;
     let mut mtail = 0u64;
     let mut rows = Vec::new();
@@ -91,14 +211,18 @@ fn main() {
         tail += hist[gm];
         mtail += max_hist[gm];
         rows.push(format!(
-            "{gm:>5}  {:>13.3e}  {:>15.3e}  {:>16.4}  {:>10.3e}",
+            "{gm:>5}  {:>13.3e}  {:>15.3e}  {:>18.3e}  {:>16.3e}  {:>16.4}  {:>10.3e}  {:>13.3e}  {:>11.3e}",
             tail as f64 / cells,
             cm.pfa_cell(gm),
+            cp.pfa_cell(gm),
+            cn.pfa_cell(gm),
             mtail as f64 / tf,
-            cm.pfa_grid(gm)
+            cm.pfa_grid(gm),
+            cp.pfa_grid(gm),
+            cn.pfa_grid(gm)
         ));
     }
-    for r in rows.iter().rev().take(20) {
+    for r in rows.iter().rev() {
         println!("{r}");
     }
     println!(
