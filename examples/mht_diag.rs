@@ -5,11 +5,12 @@
 //! `cargo run --release --example mht_diag -- LAMBDA TRIALS`
 //!
 //! False tracks with targets present (item 4 of the README's MHT-TBD section):
-//! `cargo run --release --example mht_diag -- fa LAMBDA TRIALS [GAMMA1]` runs the scene with
+//! `cargo run --release --example mht_diag -- fa LAMBDA TRIALS [GAMMA1 [noresid]]` runs the scene with
 //! its 5 targets at the default model's `gamma_1` (or `GAMMA1`), and prints for every
 //! confirmed track matching no target: its peak's raw count, plots (effective, look-back),
 //! the plots that belong to targets and to other confirmed tracks, and the peak cell's
-//! count without the plots of the other confirmed tracks.
+//! count without the plots it shares with the other confirmed tracks; `noresid` turns the detector's
+//! residual rule (`MhtConfig::residual`) off.
 use faint_core::rng::Rng;
 use faint_host::analysis::hough_model::{CellModel, ChainSource, CompoundModel};
 use faint_host::reproduce::mht::{detectors, model_params, thresholds, MATCH_TOL, NR, NT};
@@ -23,9 +24,13 @@ fn false_tracks(a: &[String]) {
         .get(4)
         .and_then(|s| s.parse().ok())
         .unwrap_or_else(|| thresholds(&sc, 1e-4).0 as u8);
+    let no_resid = a.get(5).map(String::as_str) == Some("noresid");
     let n = sc.n_scans;
-    let (mut nfa, mut n_resid_below) = (0usize, 0usize);
-    println!("lambda {lambda} trials {trials} gamma_1 {g1}");
+    let (mut nfa, mut n_resid_below, mut n_det) = (0usize, 0usize, 0usize);
+    println!(
+        "lambda {lambda} trials {trials} gamma_1 {g1} residual rule {}",
+        !no_resid
+    );
     println!("trial raw n_plots n_eff lookback target_plots(own max) in_other_tracks resid_count");
     for t in 0..trials {
         let mut rng = Rng::from_stream(4242, t);
@@ -33,9 +38,27 @@ fn false_tracks(a: &[String]) {
         let Ok((mut m, _)) = detectors(&sc, g1, n as u8) else {
             return;
         };
+        let mut cfg = *m.config();
+        cfg.residual = !no_resid;
+        if m.configure(cfg).is_err() {
+            return;
+        }
         for s in &tr.scans {
             let _ = m.step(&s.plots);
         }
+        n_det += tr
+            .targets
+            .iter()
+            .filter(|tg| {
+                m.tracks().iter().any(|trk| {
+                    let (co, si) = (trk.theta.cos(), trk.theta.sin());
+                    (0..n).all(|s| {
+                        let (x, y) = tg.position(s as f32 * sc.t_scan);
+                        (x * co + y * si - trk.c).abs() <= MATCH_TOL
+                    })
+                })
+            })
+            .count();
         let tracks = m.tracks();
         let g = *m.dmht_geometry();
         for (ti, trk) in tracks.iter().enumerate() {
@@ -75,10 +98,11 @@ fn false_tracks(a: &[String]) {
                     tr.scans[s].plots.iter().enumerate().any(|(k, p)| {
                         m.is_effective(s, k)
                             && g.rho_index_f32(p.x, p.y, aa) == r
-                            && !tracks
-                                .iter()
-                                .enumerate()
-                                .any(|(oi, o)| oi != ti && usize::from(o.plots[s]) == k)
+                            && !(usize::from(trk.plots[s]) == k
+                                && tracks
+                                    .iter()
+                                    .enumerate()
+                                    .any(|(oi, o)| oi != ti && usize::from(o.plots[s]) == k))
                     })
                 })
                 .count();
@@ -99,12 +123,115 @@ fn false_tracks(a: &[String]) {
         }
     }
     println!(
-        "false tracks {nfa} in {trials} trials; with the other tracks' plots removed, {n_resid_below} of them fall below gamma_1"
+        "false tracks {nfa} in {trials} trials; without the plots shared with other tracks, {n_resid_below} of them fall below gamma_1; targets detected (line within MATCH_TOL) {n_det} of {}",
+        trials as usize * sc.n_targets
     );
+}
+
+/// Targets found without the residual rule but not with it: the residual count of the
+/// track that found them (plots of the tracks confirmed before it removed) and what those
+/// earlier tracks were.
+fn lost_targets(a: &[String]) {
+    let lambda: f32 = a.get(2).and_then(|s| s.parse().ok()).unwrap_or(164.0);
+    let trials: u64 = a.get(3).and_then(|s| s.parse().ok()).unwrap_or(200);
+    let sc = SeaClutter::paper(lambda);
+    let g1 = a
+        .get(4)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| thresholds(&sc, 1e-4).0 as u8);
+    let n = sc.n_scans;
+    let found = |m: &faint_host::reproduce::mht::Mht,
+                 tg: &faint_host::scenario::sea_clutter::TargetTruth| {
+        m.tracks().iter().position(|trk| {
+            let (co, si) = (trk.theta.cos(), trk.theta.sin());
+            (0..n).all(|s| {
+                let (x, y) = tg.position(s as f32 * sc.t_scan);
+                (x * co + y * si - trk.c).abs() <= MATCH_TOL
+            })
+        })
+    };
+    println!("lambda {lambda} gamma_1 {g1}: trial target raw n_plots resid earlier_tracks_claiming(target plots of them)");
+    let mut lost = 0;
+    for t in 0..trials {
+        let mut rng = Rng::from_stream(4242, t);
+        let tr = sc.generate(&mut rng);
+        let (Ok((mut off, _)), Ok((mut on, _))) =
+            (detectors(&sc, g1, n as u8), detectors(&sc, g1, n as u8))
+        else {
+            return;
+        };
+        let mut cfg = *off.config();
+        cfg.residual = false;
+        if off.configure(cfg).is_err() {
+            return;
+        }
+        let (mut d_off, mut d_on) = (None, None);
+        for s in &tr.scans {
+            if let Ok(r) = off.step(&s.plots) {
+                d_off = r.detection.or(d_off);
+            }
+            if let Ok(r) = on.step(&s.plots) {
+                d_on = r.detection.or(d_on);
+            }
+        }
+        if (0..tr.targets.len())
+            .any(|i| found(&off, &tr.targets[i]).is_some() && found(&on, &tr.targets[i]).is_none())
+        {
+            println!("  off {:?}\n  on  {:?}", d_off, d_on);
+        }
+        for (i, tg) in tr.targets.iter().enumerate() {
+            let (Some(ti), None) = (found(&off, tg), found(&on, tg)) else {
+                continue;
+            };
+            lost += 1;
+            let tracks = off.tracks();
+            let trk = &tracks[ti];
+            let g = *off.dmht_geometry();
+            let (r, aa) = (usize::from(trk.peak.r), usize::from(trk.peak.a));
+            let resid = (0..n)
+                .filter(|&s| {
+                    tr.scans[s].plots.iter().enumerate().any(|(k, p)| {
+                        off.is_effective(s, k)
+                            && g.rho_index_f32(p.x, p.y, aa) == r
+                            && !(usize::from(trk.plots[s]) == k
+                                && tracks[..ti].iter().any(|o| usize::from(o.plots[s]) == k))
+                    })
+                })
+                .count();
+            let claim: Vec<String> = tracks[..ti]
+                .iter()
+                .enumerate()
+                .filter_map(|(oi, o)| {
+                    let shared = (0..n)
+                        .filter(|&s| o.plots[s] != u16::MAX && o.plots[s] == trk.plots[s])
+                        .count();
+                    let own_i = (0..n)
+                        .filter(|&s| {
+                            o.plots[s] != u16::MAX
+                                && tr.scans[s].origin[usize::from(o.plots[s])] == Origin::Target(i)
+                        })
+                        .count();
+                    (shared > 0)
+                        .then(|| format!("#{oi}: {shared} shared, {own_i}/{} of target", o.n_plots))
+                })
+                .collect();
+            println!(
+                "{t:>5} {i} {:>3} {:>3} {resid:>3} {}",
+                trk.peak.raw,
+                trk.n_plots,
+                claim.join("; ")
+            );
+        }
+    }
+    println!("lost {lost}");
 }
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
+    if a.get(1).map(String::as_str) == Some("lost") {
+        lost_targets(&a);
+        return;
+    }
     if a.get(1).map(String::as_str) == Some("fa") {
         false_tracks(&a);
         return;
