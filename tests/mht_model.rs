@@ -4,7 +4,8 @@
 
 use faint::core::rng::Rng;
 use faint::host::analysis::hough_model::{
-    self, run_value, run_value_pmf, run_value_pmf_brute, CellModel, ModelParams,
+    self, coverage_pmf, lattice_measure, run_value, run_value_pmf, run_value_pmf_brute, CellModel,
+    ChainSource, CompoundModel, ModelParams,
 };
 use faint::host::reproduce::mht::{detectors, evaluate_trial, model_params};
 use faint::host::scenario::sea_clutter::SeaClutter;
@@ -101,25 +102,125 @@ fn classic_chord_lengths() {
     assert_eq!(hough_model::chord(5000.0, 0.3, h), 0.0);
 }
 
+#[test]
+fn lattice_measure_counts_points_in_the_strip() {
+    // every point is in the strip over a measure w of offsets: sum_k k mu_k = j w
+    for (j, d, w) in [
+        (1usize, 0.7, 1.1),
+        (3, 0.0, 1.1),
+        (3, 0.3, 1.1),
+        (5, 2.0, 1.1),
+        (30, 0.05, 1.0),
+    ] {
+        let mut out = vec![0.0; j + 1];
+        lattice_measure(j, d, w, &mut out);
+        let tot: f64 = out.iter().enumerate().map(|(k, m)| k as f64 * m).sum();
+        assert!((tot - j as f64 * w).abs() < 1e-9, "j={j} d={d}: {tot}");
+    }
+    // collinear (d = 0): all j points together over w
+    let mut out = vec![0.0; 4];
+    lattice_measure(3, 0.0, 1.0, &mut out);
+    assert_eq!(out, vec![0.0, 0.0, 0.0, 1.0]);
+    // spacing 0.4 in a strip of width 1
+    let mut out = vec![0.0; 4];
+    lattice_measure(3, 0.4, 1.0, &mut out);
+    // u0 + {0, .4, .8} in [0, 1): 3 points for u0 in [0, .2); 2 for [-.4, 0) and [.2, .6);
+    // 1 for [-.8, -.4) and [.6, 1)
+    assert!(
+        (out[3] - 0.2).abs() < 1e-12
+            && (out[2] - 0.8).abs() < 1e-12
+            && (out[1] - 0.8).abs() < 1e-12
+    );
+}
+
+#[test]
+fn coverage_dp_matches_closed_form_and_simulation() {
+    // only single-scan intervals: each scan covered independently with 1 - exp(-nu)
+    let n = 12;
+    let nu1 = 0.3;
+    let nu: Vec<Vec<f64>> = (0..n)
+        .map(|_| (0..=n).map(|k| if k == 1 { nu1 } else { 0.0 }).collect())
+        .collect();
+    let dp = coverage_pmf(n, &nu);
+    let bin = hough_model::binomial_pmf(n, 1.0 - f64::exp(-nu1));
+    for (a, b) in dp.iter().zip(&bin) {
+        assert!((a - b).abs() < 1e-12);
+    }
+    // mixed lengths, starts uniform over 0..=n-k: against 200 000 simulated Boolean models
+    // (5 sd of a frequency <= 5 * sqrt(0.25 / 2e5) = 5.6e-3)
+    let lam = [0.0, 0.8, 0.3, 0.2, 0.1, 0.05];
+    let nu: Vec<Vec<f64>> = (0..n)
+        .map(|t| {
+            (0..=n)
+                .map(|k| {
+                    if k == 0 || k >= lam.len() || t + k > n {
+                        0.0
+                    } else {
+                        lam[k] / (n - k + 1) as f64
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let dp = coverage_pmf(n, &nu);
+    assert!((dp.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+    let mut rng = Rng::seed_from_u64(77);
+    let trials = 200_000u32;
+    let mut counts = vec![0u32; n + 1];
+    let poisson = |rng: &mut Rng, mu: f64| {
+        let (mut k, mut p, l) = (0u32, 1.0f64, (-mu).exp());
+        loop {
+            p *= f64::from(rng.uniform_open0());
+            if p <= l {
+                return k;
+            }
+            k += 1;
+        }
+    };
+    for _ in 0..trials {
+        let mut cov = vec![false; n];
+        for (k, &l) in lam.iter().enumerate().skip(1) {
+            for _ in 0..poisson(&mut rng, l) {
+                let t0 = rng.below((n - k + 1) as u32) as usize;
+                cov[t0..t0 + k].iter_mut().for_each(|c| *c = true);
+            }
+        }
+        counts[cov.iter().filter(|c| **c).count()] += 1;
+    }
+    for v in 0..=n {
+        let f = f64::from(counts[v]) / f64::from(trials);
+        assert!((f - dp[v]).abs() < 5.6e-3, "v={v}: sim {f} vs dp {}", dp[v]);
+    }
+}
+
 /// The model's threshold in simulation: clutter-only periods through the full detector,
-/// largest DMHT count per period. The test level is a grid Pfa of 0.3 so that 150
-/// periods resolve it (binomial sd 0.037). Measured with 1000 periods per lambda
-/// (README, `out/mht/null_pfa.csv`): the simulated threshold for a given Pfa matches the
-/// model's within one count at lambda = 80 and 398, but the model is optimistic by 2-4
-/// counts at lambda = 164..316 (its Pfa at its own gamma_1 is 1e-5..5e-5 where the
-/// simulation gives ~1e-2). The test pins both facts: +-1 count at the ends, and at most
-/// 4 counts (never the other way) in the middle.
+/// largest DMHT count per period, against the compound law with `N_t = 0` (what such a
+/// period holds). Level: grid Pfa 0.1 so that 400 periods resolve it (binomial sd 0.015).
+/// Measured with 10 000 periods per lambda (README "Compound law: validation"): the
+/// compound law's grid Pfa is never below the simulated one, and its threshold for a given
+/// Pfa is the simulated one or one count above (conservative: branched chains are
+/// counted twice, and the model's `drho` is the MSHT's 33 m while the DMHT's is smaller at
+/// low lambda), two at lambda 398 at this level (its effective clutter density is 24 %
+/// high there: 66.7 vs 53.9 plots per scan; one count at the 1e-4 level). The test
+/// asserts exactly that, `g_sim <= g_model <= g_sim + slack`; the paper variant (eq. 20-26)
+/// is optimistic by 2-4 counts at lambda 164-316 (`g_model < g_sim`).
 #[test]
 fn model_threshold_holds_in_simulation() {
-    for (lambda, below, above) in [(80.0f32, 1usize, 1usize), (237.0, 0, 4), (398.0, 1, 1)] {
+    for (lambda, slack) in [
+        (80.0f32, 1usize),
+        (164.0, 1),
+        (237.0, 1),
+        (316.0, 1),
+        (398.0, 2),
+    ] {
         let mut sc = SeaClutter::paper(lambda);
-        // the threshold is the one the reproduction uses: model with the scene's N_t = 5
-        let cm = CellModel::new(model_params(&sc));
         sc.n_targets = 0;
-        let g_model = cm.gamma_for_pfa(0.3);
+        let cm = CompoundModel::new(model_params(&sc), ChainSource::Censoring);
+        let level = 0.1;
+        let g_model = cm.gamma_for_pfa(level);
         let (mut m, mut c) = detectors(&sc, g_model as u8, 30).unwrap();
         let mut rng = Rng::seed_from_u64(2024 + lambda as u64);
-        let trials = 150;
+        let trials = 400;
         let maxes: Vec<u8> = (0..trials)
             .map(|_| {
                 let tr = sc.generate(&mut rng);
@@ -129,34 +230,38 @@ fn model_threshold_holds_in_simulation() {
         let sim_pfa = |g: usize| {
             maxes.iter().filter(|&&x| usize::from(x) >= g).count() as f64 / trials as f64
         };
-        let g_sim = (1..=30).find(|&g| sim_pfa(g) <= 0.3).unwrap();
+        let g_sim = (1..=31).find(|&g| sim_pfa(g) <= level).unwrap();
         eprintln!(
             "lambda {lambda}: model gamma {g_model} (model Pfa {:.3}, sim Pfa {:.3}); sim gamma {g_sim}",
             cm.pfa_grid(g_model),
             sim_pfa(g_model)
         );
         assert!(
-            g_sim + below >= g_model && g_sim <= g_model + above,
+            g_sim <= g_model && g_model <= g_sim + slack,
             "lambda {lambda}: model {g_model}, sim {g_sim}"
         );
     }
 }
 
-/// Where the model-vs-simulation gap lives (README "Why the model and simulation
-/// differ"), lambda 164, 300 clutter-only periods, model with `N_t = 0`:
+/// Where the paper model's gap lives and that the compound law closes it (README "Why the
+/// model and simulation differ"), lambda 164, 300 clutter-only periods, models with
+/// `N_t = 0`:
 /// (1) eq. 28 applied to the *simulated* per-cell tail reproduces the simulated grid Pfa
 /// (measured with 1000 periods: 0.086 vs 0.081 at gamma 10), so cell correlation is not
-/// the cause; the factor-2 band leaves room for the binomial error of ~60-100 periods
+/// the cause; the factor-2 band leaves room for the binomial error of ~30-100 periods
 /// above the level and for mild clustering of high cells.
-/// (2) the model's cell law `P0` (eq. 25) is far too light in its tail: measured
-/// 1.1e-5 (sim) vs 2.1e-9 (model) at gamma 9, ~5000x; the test asserts > 100x, so it
-/// fails once the cross-track correction (eq. 20-26) is replaced by one that describes
-/// the stacking of clutter chains (then tighten `model_threshold_holds_in_simulation`).
+/// (2) the paper's cell law `P0` (eq. 25) is far too light in its tail: measured 1.2e-5
+/// (sim) vs 2.1e-9 (paper) at gamma 9, ~5000x; asserted > 100x.
+/// (3) the compound law's mean cell tail is within [0.7, 3] x the simulated one (measured
+/// with 10 000 periods: 1.58x at gamma 9, 1.76x at 10; here 1.8x, 2.0x); with 300 periods the simulated
+/// tail at gamma 10 rests on ~35 cells from ~30 periods (chains make high cells come in
+/// groups), so its error is ~+-30 %, hence the band.
 #[test]
-fn grid_gap_is_in_the_cell_law_not_in_eq28() {
+fn compound_law_closes_the_cell_gap() {
     let mut sc = SeaClutter::paper(164.0);
     sc.n_targets = 0;
     let cm = CellModel::new(model_params(&sc));
+    let cp = CompoundModel::new(model_params(&sc), ChainSource::Censoring);
     let n = sc.n_scans;
     let (mut m, _) = detectors(&sc, n as u8, n as u8).unwrap();
     let mut rng = Rng::seed_from_u64(4164);
@@ -186,8 +291,9 @@ fn grid_gap_is_in_the_cell_law_not_in_eq28() {
         let grid_sim = tail(&max_hist, g) / periods as f64;
         let grid_eq28 = -(cells * (-cell_sim).ln_1p()).exp_m1();
         eprintln!(
-            "gamma {g}: cell sim {cell_sim:.3e} model {:.3e}; grid sim {grid_sim:.3} eq28(sim cell) {grid_eq28:.3}",
-            cm.pfa_cell(g)
+            "gamma {g}: cell sim {cell_sim:.3e} paper {:.3e} compound {:.3e}; grid sim {grid_sim:.3} eq28(sim cell) {grid_eq28:.3}",
+            cm.pfa_cell(g),
+            cp.pfa_cell(g)
         );
         assert!(
             grid_eq28 <= 2.0 * grid_sim && grid_sim <= 2.0 * grid_eq28,
@@ -195,8 +301,53 @@ fn grid_gap_is_in_the_cell_law_not_in_eq28() {
         );
         assert!(
             cell_sim > 100.0 * cm.pfa_cell(g),
-            "gamma {g}: model cell tail {:.3e} no longer far below simulation {cell_sim:.3e}",
+            "gamma {g}: paper cell tail {:.3e} no longer far below simulation {cell_sim:.3e}",
             cm.pfa_cell(g)
         );
+        let r = cp.pfa_cell(g) / cell_sim;
+        assert!(
+            (0.7..=3.0).contains(&r),
+            "gamma {g}: compound cell tail {:.3e} vs simulation {cell_sim:.3e}",
+            cp.pfa_cell(g)
+        );
     }
+}
+
+/// The residual rule (`MhtConfig::residual`: a later peak must reach `gamma_1` without the
+/// plots its track shares with the tracks confirmed before it) against target-induced
+/// false tracks, lambda 164 at the paper law's `gamma_1 = 11` (where they are frequent),
+/// 300 trials with the scene's 5 targets, same seeds with the rule on and off. Measured
+/// with 2000 trials (`mht_diag fa 164 2000 11 [noresid]`): 71 false tracks without the
+/// rule (66 of them below `gamma_1` without their plots shared with other tracks), 11 with
+/// it; targets whose line is found 9668 vs 9652 of 10 000. Expected here ~11 vs ~2: the
+/// test asserts at least a 3x cut and at most 1 % of the targets lost (the paired
+/// difference is ~0.2 %, a handful of targets in 1500).
+#[test]
+fn residual_rule_removes_target_induced_false_tracks() {
+    let sc = SeaClutter::paper(164.0);
+    let trials = 300u64;
+    let mut out = [(0u32, 0u32); 2];
+    for (i, residual) in [false, true].into_iter().enumerate() {
+        let (mut m, mut c) = detectors(&sc, 11, 31).unwrap();
+        let mut cfg = *m.config();
+        cfg.residual = residual;
+        m.configure(cfg).unwrap();
+        for t in 0..trials {
+            let mut rng = Rng::from_stream(9164, t);
+            let tr = sc.generate(&mut rng);
+            let st = evaluate_trial(&sc, &tr, &mut m, &mut c);
+            out[i].0 += st.mht_false;
+            out[i].1 += st.mht_detected;
+        }
+    }
+    eprintln!(
+        "without the rule: {:?}, with: {:?} (false tracks, targets detected)",
+        out[0], out[1]
+    );
+    assert!(out[0].0 >= 3 * out[1].0.max(1), "{out:?}");
+    let n = (trials * 5) as f64;
+    assert!(
+        f64::from(out[1].1) >= f64::from(out[0].1) - 0.01 * n,
+        "{out:?}"
+    );
 }

@@ -26,7 +26,7 @@ use faint_core::detect::hough::{
     ClassicConfig, ClassicHough, Geometry, MhtConfig, MhtTbd, NO_PLOT,
 };
 
-use crate::analysis::hough_model::{self, CellModel, ModelParams};
+use crate::analysis::hough_model::{self, CellModel, ChainSource, CompoundModel, ModelParams};
 use crate::scenario::sea_clutter::{Origin, SeaClutter, Trial};
 
 /// Plots per scan capacity (Poisson(398) exceeds 520 with probability ~1e-9).
@@ -73,6 +73,64 @@ pub struct Args {
     /// CI size: 20 trials, 20 null trials.
     #[arg(long)]
     pub quick: bool,
+    /// Per-cell clutter law that sets `gamma_1`: `paper` (eq. 20-26 as published) or
+    /// `compound` (chain-stacking law, the default: holds the wanted Pfa in simulation);
+    /// `compound-nc` is the compound law with the paper's `N_c` chains (for comparison).
+    #[arg(long, value_enum, default_value_t = ModelChoice::Compound)]
+    pub model: ModelChoice,
+}
+
+/// `--model` values.
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub enum ModelChoice {
+    /// Eq. 20-26 as published.
+    Paper,
+    /// Compound law, chains from the censoring rule (default).
+    #[default]
+    Compound,
+    /// Compound law with the paper's `N_c` clutter tracks.
+    CompoundNc,
+}
+
+/// A grid false-alarm model of either kind.
+#[derive(Debug, Clone)]
+pub enum GridModel {
+    /// Eq. 20-26.
+    Paper(CellModel),
+    /// Compound law.
+    Compound(CompoundModel),
+}
+
+impl GridModel {
+    /// Build the chosen model.
+    pub fn new(mp: ModelParams, choice: ModelChoice) -> Self {
+        match choice {
+            ModelChoice::Paper => Self::Paper(CellModel::new(mp)),
+            ModelChoice::Compound => Self::Compound(CompoundModel::new(mp, ChainSource::Censoring)),
+            ModelChoice::CompoundNc => Self::Compound(CompoundModel::new(mp, ChainSource::PaperNc)),
+        }
+    }
+    /// Whole-grid Pfa at `gamma`.
+    pub fn pfa_grid(&self, gamma: usize) -> f64 {
+        match self {
+            Self::Paper(m) => m.pfa_grid(gamma),
+            Self::Compound(m) => m.pfa_grid(gamma),
+        }
+    }
+    /// Mean cell Pfa at `gamma`.
+    pub fn pfa_cell(&self, gamma: usize) -> f64 {
+        match self {
+            Self::Paper(m) => m.pfa_cell(gamma),
+            Self::Compound(m) => m.pfa_cell(gamma),
+        }
+    }
+    /// Smallest `gamma` with grid Pfa `<= pfa`.
+    pub fn gamma_for_pfa(&self, pfa: f64) -> usize {
+        match self {
+            Self::Paper(m) => m.gamma_for_pfa(pfa),
+            Self::Compound(m) => m.gamma_for_pfa(pfa),
+        }
+    }
 }
 
 /// Everything measured in one trial.
@@ -271,12 +329,17 @@ pub fn detectors(
     Ok((mht, classic))
 }
 
-/// Thresholds for a lambda: `(gamma_1 from the MHT model, classic gamma from the binomial
-/// strip model)`, both for whole-grid `Pfa <= pfa`, clamped to `1..=N` (a threshold above
-/// `N` cannot be met: the detector then never fires).
+/// [`thresholds_with`] the default model ([`ModelChoice::Compound`]).
 pub fn thresholds(sc: &SeaClutter, pfa: f64) -> (usize, usize) {
+    thresholds_with(sc, pfa, ModelChoice::default())
+}
+
+/// Thresholds for a lambda: `(gamma_1 from the MHT model `choice`, classic gamma from the
+/// binomial strip model)`, both for whole-grid `Pfa <= pfa` (`N + 1` when no threshold
+/// reaches it: the detector then never fires).
+pub fn thresholds_with(sc: &SeaClutter, pfa: f64, choice: ModelChoice) -> (usize, usize) {
     let mp = model_params(sc);
-    let g1 = CellModel::new(mp).gamma_for_pfa(pfa);
+    let g1 = GridModel::new(mp, choice).gamma_for_pfa(pfa);
     let gc = hough_model::classic_gamma(
         f64::from(sc.area[1] - sc.area[0]),
         NR,
@@ -531,6 +594,7 @@ struct Summary {
     clutter_per_scan_before: f64,
     clutter_per_scan_after: f64,
     clutter_after_model: f64,
+    clutter_after_compound: f64,
     target_plots_kept: f64,
     mht_pd: f64,
     mht_pd_lo: f64,
@@ -581,7 +645,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut null_rows = Vec::new();
     for (li, &lambda) in args.lambda.iter().enumerate() {
         let sc = SeaClutter::paper(lambda);
-        let (g1, gc) = thresholds(&sc, args.pfa);
+        let (g1, gc) = thresholds_with(&sc, args.pfa, args.model);
         let g1 = args.gamma1.map_or(g1, usize::from);
         let g1u = g1.clamp(1, 255) as u8;
         let gcu = gc.clamp(1, 255) as u8;
@@ -621,6 +685,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let (pd, lo, hi) = proportion_ci(det, (trials * sc.n_targets) as u64);
         let cdet = sum(&|t| t.classic_detected);
         let cm = CellModel::new(model_params(&sc));
+        // the clutter-only periods are compared with the chosen model for N_t = 0
+        let null_model = GridModel::new(model_params(&null_sc), args.model);
         let m0 = cm
             .p0_raw
             .iter()
@@ -655,7 +721,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 lambda,
                 gamma: g,
                 sim_pfa: k as f64 / null_trials.max(1) as f64,
-                model_pfa: cm.pfa_grid(g),
+                model_pfa: null_model.pfa_grid(g),
                 classic_sim_pfa: kc as f64 / null_trials.max(1) as f64,
             });
         }
@@ -668,6 +734,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             clutter_per_scan_before: sum(&|t| t.pre_clutter) as f64 / n_scans,
             clutter_per_scan_after: sum(&|t| t.eff_clutter) as f64 / n_scans,
             clutter_after_model: after_model,
+            clutter_after_compound: CompoundModel::new(
+                model_params(&null_sc),
+                ChainSource::Censoring,
+            )
+            .clutter_per_scan(),
             target_plots_kept: sum(&|t| t.eff_target) as f64
                 / sum(&|t| t.target_plots).max(1) as f64,
             mht_pd: pd,
@@ -686,7 +757,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             null_pfa_sim: np,
             null_pfa_lo: nlo,
             null_pfa_hi: nhi,
-            null_pfa_model: cm.pfa_grid(g1),
+            null_pfa_model: null_model.pfa_grid(g1),
             null_confirmed_fa_trials: nres.iter().filter(|t| t.mht_false > 0).count() as u64,
             classic_null_pfa_sim: chit / null_trials.max(1) as f64,
         });
@@ -711,6 +782,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             (
                 "after (model N_c m0 / N)".into(),
                 xs(&|s| s.clutter_after_model),
+            ),
+            (
+                "after (compound chains)".into(),
+                xs(&|s| s.clutter_after_compound),
             ),
         ],
         true,
@@ -759,17 +834,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     )?;
     // markdown
     let mut md = String::new();
-    md += &format!("Trials per lambda: {trials} with 5 targets, {null_trials} clutter-only; thresholds for grid Pfa <= {}.\n\n", args.pfa);
-    md += "| lambda | gamma_1 | clutter/scan before | after (sim) | after (model) | target plots kept | MHT Pd [95% CI] | MHT false tracks (trials with FA) | plot loss | wrong plot | classic gamma | classic Pd | classic false peaks (trials with FA) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    md += &format!("Trials per lambda: {trials} with 5 targets, {null_trials} clutter-only; thresholds for grid Pfa <= {} from the {:?} model.\n\n", args.pfa, args.model);
+    md += "| lambda | gamma_1 | clutter/scan before | after (sim) | after (paper N_c m0 / N) | after (compound chains) | target plots kept | MHT Pd [95% CI] | MHT false tracks (trials with FA) | plot loss | wrong plot | classic gamma | classic Pd | classic false peaks (trials with FA) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for s in &summaries {
         md += &format!(
-            "| {} | {} | {:.1} | {:.2} | {:.2} | {:.3} | {:.3} [{:.3}, {:.3}] | {} ({}) | {:.3} | {:.3} | {} | {:.3} | {} ({}) |\n",
-            s.lambda, s.gamma1, s.clutter_per_scan_before, s.clutter_per_scan_after, s.clutter_after_model, s.target_plots_kept,
+            "| {} | {} | {:.1} | {:.2} | {:.2} | {:.2} | {:.3} | {:.3} [{:.3}, {:.3}] | {} ({}) | {:.3} | {:.3} | {} | {:.3} | {} ({}) |\n",
+            s.lambda, s.gamma1, s.clutter_per_scan_before, s.clutter_per_scan_after, s.clutter_after_model, s.clutter_after_compound, s.target_plots_kept,
             s.mht_pd, s.mht_pd_lo, s.mht_pd_hi, s.mht_false_tracks, s.mht_trials_with_fa, s.plot_loss, s.wrong_plot,
             s.gamma_classic, s.classic_pd, s.classic_false_peaks, s.classic_trials_with_fa
         );
     }
-    md += "\nModel threshold in clutter-only simulation (largest DMHT count >= gamma_1, before track confirmation; and periods with a confirmed track):\n\n| lambda | gamma_1 | sim grid Pfa [95% CI] | model grid Pfa (eq. 28) | periods with a confirmed false track | classic sim Pfa at its gamma |\n|---|---|---|---|---|---|\n";
+    md += "\nModel threshold in clutter-only simulation (largest DMHT count >= gamma_1, before track confirmation; and periods with a confirmed track):\n\n| lambda | gamma_1 | sim grid Pfa [95% CI] | model grid Pfa (eq. 28, N_t = 0) | periods with a confirmed false track | classic sim Pfa at its gamma |\n|---|---|---|---|---|---|\n";
     for s in &summaries {
         md += &format!(
             "| {} | {} | {:.4} [{:.4}, {:.4}] | {:.2e} | {} / {} | {:.4} |\n",

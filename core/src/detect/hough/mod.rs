@@ -93,6 +93,13 @@ pub struct MhtConfig {
     pub confirm_frac: f32,
     /// Smallest DMHT rho half-range (m) (degenerate geometry).
     pub drho_min: f32,
+    /// Sequential extraction: a peak after the first confirmed track is confirmed only if
+    /// its cell's binary-integration count, without the plots its track shares with the
+    /// tracks confirmed so far (peaks are taken strongest first), still reaches `gamma_1`:
+    /// the threshold test applied to what the confirmed tracks do not explain. Rejects
+    /// lines through a run of a detected target's plots plus clutter (extension; measured
+    /// in the README). Plots of other tracks that merely cross the cell still count.
+    pub residual: bool,
 }
 
 impl MhtConfig {
@@ -113,6 +120,7 @@ impl MhtConfig {
             min_track_plots: 3,
             confirm_frac: 0.75,
             drho_min: 50.0,
+            residual: true,
         }
     }
 
@@ -168,6 +176,9 @@ pub struct Detection {
     /// Peaks whose track had more than half its plots already in stronger tracks (a
     /// second peak of one target, or a line across several targets' tracks).
     pub merged: u16,
+    /// Peaks whose cell count without the confirmed tracks' plots is below `gamma_1`
+    /// ([`MhtConfig::residual`]).
+    pub residual: u16,
 }
 
 /// One step's report.
@@ -464,6 +475,30 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
             if dup {
                 det.merged += 1;
                 continue;
+            }
+            if self.cfg.residual && nt > 0 {
+                let pk = self.peaks[i];
+                let (r, a) = (usize::from(pk.r), usize::from(pk.a));
+                let mut resid = 0u8;
+                for s in 0..ns {
+                    let tracks = &self.tracks[..nt];
+                    let hit = (0..usize::from(self.counts[s])).any(|k| {
+                        if self.flags[s][k] & FLAG_EFFECTIVE == 0
+                            || (usize::from(tr.plots[s]) == k
+                                && tracks.iter().any(|o| o.plots[s] == tr.plots[s]))
+                        {
+                            return false;
+                        }
+                        let p = self.plots[s][k];
+                        let (xq, yq) = self.dmht.quantise(p.x, p.y);
+                        self.dmht.rho_index_q(xq, yq, a) == r
+                    });
+                    resid = resid.saturating_add(u8::from(hit));
+                }
+                if resid < self.cfg.gamma1 {
+                    det.residual += 1;
+                    continue;
+                }
             }
             self.tracks[nt] = tr;
             nt += 1;
