@@ -49,7 +49,6 @@
 //! large instances in a `Box`, or zeroed in a `static` and set up by
 //! [`CrpfTbd::reconfigure`].
 
-use crate::existence::Transition;
 use crate::math;
 use crate::model::doppler::{check_frame, FrameDetector, Model, ModelConfig, TbdReport, MAX_BINS};
 use crate::particles::{resample, Scheme};
@@ -178,6 +177,46 @@ fn gather_particles(parts: &mut [Particle], anc: &[u32]) {
         if (a as usize) < j {
             copy(parts, j, a as usize);
         }
+    }
+}
+
+/// The existence draw of eq. 9 in integers, bit-identical to
+/// [`ExistenceMarkov::sample`](crate::existence::ExistenceMarkov::sample): that draws
+/// `u = (x >> 8) 2^-24` from one `u32` `x` and compares `u < p`; `p 2^24` is exact in
+/// `f32`, so `u < p` is `(x >> 8) < ceil(p 2^24)` for the whole number `x >> 8`.
+#[derive(Debug, Clone, Copy)]
+struct ExistenceDraw {
+    /// `ceil(Pb 2^24)`.
+    birth: u32,
+    /// `ceil(Pd 2^24)`.
+    death: u32,
+}
+
+impl ExistenceDraw {
+    fn new(chain: &crate::existence::ExistenceMarkov) -> Self {
+        // p in [0, 1] (validated by the chain), so p 2^24 in [0, 2^24] is exact.
+        let ceil = |p: f32| {
+            let t = p * 16_777_216.0;
+            let f = t as u32;
+            if (f as f32) < t {
+                f + 1
+            } else {
+                f
+            }
+        };
+        Self {
+            birth: ceil(chain.birth()),
+            death: ceil(chain.death()),
+        }
+    }
+
+    /// `E_k` given `E_{k-1} = existed`, from one draw: the flag flips (birth or death)
+    /// when the draw falls below the row's threshold.
+    #[inline(always)]
+    fn next(&self, existed: bool, rng: &mut Rng) -> bool {
+        let u = rng.next_u32() >> 8;
+        let thr = if existed { self.death } else { self.birth };
+        existed != (u < thr)
     }
 }
 
@@ -345,19 +384,21 @@ impl<const N: usize> CrpfTbd<N> {
         let obs = &self.model.obs;
         let motion = &self.model.motion;
         let prior = &self.model.prior;
-        let chain = &self.model.chain;
+        let draw = ExistenceDraw::new(&self.model.chain);
         // Squared residual of every predicted particle, and the smallest.
         let mut dmin = f32::INFINITY;
         // A local copy keeps the generator's state in registers across the loop.
         let mut rng = self.rng.clone();
         for (pt, out) in self.parts.iter().zip(self.log_w.iter_mut()) {
-            let t = chain.sample(pt.e, &mut rng);
-            *out = match t {
-                Transition::Continuing => {
+            let next = draw.next(pt.e, &mut rng);
+            *out = match (pt.e, next) {
+                (true, true) => {
+                    // Continuing.
                     let xp = motion.predict(pt.x);
                     obs.project_re(z, xp[0], xp[2]).residual_norm2(zz)
                 }
-                Transition::Born => {
+                (false, true) => {
+                    // Born.
                     let xb = prior.sample(&mut rng);
                     obs.project_re(z, xb[0], xb[2]).residual_norm2(zz)
                 }
@@ -441,6 +482,7 @@ impl<const N: usize> CrpfTbd<N> {
         let mut arg = None;
         let ln_free = self.int_exponent.is_some();
         let mut rng = self.rng.clone();
+        let draw = ExistenceDraw::new(&self.model.chain);
         let absent_log_c = if ln_free {
             zz_floor
         } else {
@@ -448,9 +490,10 @@ impl<const N: usize> CrpfTbd<N> {
         };
         for i in 0..N {
             let par = self.parts[i];
-            let t = self.model.chain.sample(par.e, &mut rng);
-            let cand = match t {
-                Transition::Continuing => {
+            let next_e = draw.next(par.e, &mut rng);
+            let cand = match (par.e, next_e) {
+                (true, true) => {
+                    // Continuing: x ~ N(F xbar, Sigma).
                     let xp = self.model.motion.predict(par.x);
                     let a = xp[2] + js[2] * rng.normal();
                     Some([
@@ -459,7 +502,7 @@ impl<const N: usize> CrpfTbd<N> {
                         if a < 0.0 { -a } else { a },
                     ])
                 }
-                Transition::Born => Some(self.model.prior.sample(&mut rng)),
+                (false, true) => Some(self.model.prior.sample(&mut rng)),
                 _ => None,
             };
             let mut next = Particle {
