@@ -133,11 +133,13 @@ impl CrpfConfig {
     }
 }
 
-/// One CRPF-TBD particle.
+/// The state of one CRPF-TBD particle; its existence flag `E` lives in a separate array
+/// ([`CrpfTbd`] keeps structure-of-arrays flags), so that an absent particle costs one
+/// byte to move. When `lambda = 0` every `E = 0` particle has `x = 0`, `h = 0` and the
+/// same cost, so its `Particle` is never read and is left stale (not written at all).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 struct Particle {
     x: [f32; 3],
-    e: bool,
     /// `ln C` (`-inf` for `C = 0`); on the ln-free path (`int_exponent`), the squared
     /// residual `d2 = C^(2/p)` instead (0 before the first frame).
     log_c: f32,
@@ -147,20 +149,32 @@ struct Particle {
     hh: f32,
 }
 
-/// `parts[j] = old parts[anc[j]]` in place for sorted ancestors (what
-/// [`resample`] produces), like [`gather_in_place`](crate::particles::gather_in_place) but copying field by field: a
+/// `parts[j] = old parts[anc[j]]`, `exists[j] = old exists[anc[j]]` in place for sorted
+/// ancestors (what [`resample`] produces), like
+/// [`gather_in_place`](crate::particles::gather_in_place) but copying field by field (a
 /// whole-struct copy inside one slice compiles to a `memmove` call per particle on the
-/// M4. Same two passes (ascending for `a > j`, descending for `a < j`).
-fn gather_particles(parts: &mut [Particle], anc: &[u32]) {
+/// M4) and, unless `all`, copying the state only of `E = 1` particles (with `lambda = 0`
+/// an absent particle's state is never read). Same two passes (ascending for `a > j`,
+/// descending for `a < j`).
+fn gather_particles(parts: &mut [Particle], exists: &mut [bool], anc: &[u32], all: bool) {
     #[inline(always)]
-    fn copy(parts: &mut [Particle], j: usize, a: usize) {
+    fn copy(parts: &mut [Particle], exists: &mut [bool], j: usize, a: usize, all: bool) {
+        let e = match exists.get(a) {
+            Some(&e) => e,
+            None => return,
+        };
+        if let Some(d) = exists.get_mut(j) {
+            *d = e;
+        }
+        if !(e || all) {
+            return;
+        }
         if let Some(&s) = parts.get(a) {
-            let (x, e, log_c, zh, hh) = (s.x, s.e, s.log_c, s.zh, s.hh);
+            let (x, log_c, zh, hh) = (s.x, s.log_c, s.zh, s.hh);
             if let Some(d) = parts.get_mut(j) {
                 d.x[0] = x[0];
                 d.x[1] = x[1];
                 d.x[2] = x[2];
-                d.e = e;
                 d.log_c = log_c;
                 d.zh.re = zh.re;
                 d.zh.im = zh.im;
@@ -170,12 +184,12 @@ fn gather_particles(parts: &mut [Particle], anc: &[u32]) {
     }
     for (j, &a) in anc.iter().enumerate() {
         if a as usize > j {
-            copy(parts, j, a as usize);
+            copy(parts, exists, j, a as usize, all);
         }
     }
     for (j, &a) in anc.iter().enumerate().rev() {
         if (a as usize) < j {
-            copy(parts, j, a as usize);
+            copy(parts, exists, j, a as usize, all);
         }
     }
 }
@@ -230,6 +244,17 @@ fn log_add_exp(a: f32, b: f32) -> f32 {
     hi + math::ln1p(math::exp(lo - hi))
 }
 
+/// `ln C` of a squared residual `d2`, with forgetting of the parent cost (eq. 11).
+#[inline]
+fn log_cost(cfg: &CrpfConfig, d2: f32, parent_log_c: f32, ln_lambda: f32) -> f32 {
+    let c = 0.5 * cfg.p * math::ln(d2);
+    if cfg.lambda > 0.0 {
+        log_add_exp(ln_lambda + parent_log_c, c)
+    } else {
+        c
+    }
+}
+
 /// `x^n` for a small whole `n >= 1` by repeated squaring.
 #[inline]
 fn powi(x: f32, mut n: u32) -> f32 {
@@ -270,12 +295,115 @@ fn int_exponent(cfg: &CrpfConfig) -> Option<u32> {
     }
 }
 
+/// What step (4) needs for one particle that exists after the existence draw.
+struct UpdateCtx<'a> {
+    model: &'a Model,
+    cfg: &'a CrpfConfig,
+    z: &'a [Complex32],
+    zz: f32,
+    /// `||m_k||^2 = ||z_k||^2 + ||z_{k-1}||^2`.
+    norm_m2: f32,
+    r_th2: f32,
+    ln_free: bool,
+    ln_lambda: f32,
+}
+
+impl UpdateCtx<'_> {
+    /// Step (4) for a particle with `E_k = 1`: jitter `x ~ N(F xbar, Sigma)` if it
+    /// continues (`existed`), a birth from `U(I_x0)` otherwise, then the gate (eq. 10)
+    /// and the cost. On a pass writes the new state into `slot` and returns its cost;
+    /// on a rejection leaves `slot` untouched. Out of line, with the generator by value,
+    /// so that the loop over mostly absent particles keeps its state in registers.
+    #[inline(never)]
+    fn update_present(
+        &self,
+        slot: &mut Particle,
+        existed: bool,
+        mut rng: Rng,
+    ) -> (Rng, Option<f32>) {
+        let par = *slot;
+        let motion = &self.model.motion;
+        let js = self.cfg.jitter_std;
+        let (x, par_zh, par_hh) = if existed {
+            let xp = motion.predict(par.x);
+            let a = xp[2] + js[2] * rng.normal();
+            (
+                [
+                    motion.wrap(xp[0] + js[0] * rng.normal()),
+                    xp[1] + js[1] * rng.normal(),
+                    if a < 0.0 { -a } else { a },
+                ],
+                par.zh,
+                par.hh,
+            )
+        } else {
+            // Born: the parent had E = 0, so its zh, hh are 0.
+            (
+                self.model.prior.sample(&mut rng),
+                Complex32::new(0.0, 0.0),
+                0.0,
+            )
+        };
+        let pr = self.model.obs.project(self.z, x[0], x[2]);
+        // Gate (eq. 10). r >= r_th  <=>  |<m, m^i>|^2 >= r_th^2 ||m||^2 ||m^i||^2 (no sqrt).
+        let r_th = self.cfg.r_th;
+        let num2 = (pr.zh + par_zh).norm_sqr();
+        let den2 = self.norm_m2 * (pr.hh + par_hh);
+        let pass = if den2.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
+            r_th <= 0.0 // r = 0
+        } else if num2.is_finite() && den2.is_finite() {
+            num2 >= self.r_th2 * den2
+        } else {
+            (pr.zh + par_zh).norm() / math::sqrt(den2) >= r_th
+        };
+        if !pass {
+            return (rng, None);
+        }
+        let d2 = pr.residual_norm2(self.zz);
+        let log_c = if self.ln_free {
+            d2
+        } else {
+            log_cost(self.cfg, d2, par.log_c, self.ln_lambda)
+        };
+        *slot = Particle {
+            x,
+            log_c,
+            zh: pr.zh,
+            hh: pr.hh,
+        };
+        (rng, Some(log_c))
+    }
+}
+
+/// Step (2) for a particle with `E_k = 1` in the prediction: `||z - h(x)||^2` of `F x`
+/// (`existed`) or of a birth from `U(I_x0)`. Out of line, generator by value (see
+/// [`UpdateCtx::update_present`]).
+#[inline(never)]
+fn risk_present(
+    model: &Model,
+    z: &[Complex32],
+    zz: f32,
+    x: &[f32; 3],
+    existed: bool,
+    mut rng: Rng,
+) -> (Rng, f32) {
+    let xp = if existed {
+        model.motion.predict(*x)
+    } else {
+        model.prior.sample(&mut rng)
+    };
+    let d2 = model.obs.project_re(z, xp[0], xp[2]).residual_norm2(zz);
+    (rng, d2)
+}
+
 /// CRPF-TBD with `N` particles.
 #[derive(Debug, Clone)]
 pub struct CrpfTbd<const N: usize> {
     cfg: CrpfConfig,
     model: Model,
     parts: [Particle; N],
+    /// `E` of each particle.
+    exists: [bool; N],
     /// Log risks, then log weights; reused as scratch.
     log_w: [f32; N],
     w: [f32; N],
@@ -303,6 +431,7 @@ impl<const N: usize> CrpfTbd<N> {
             cfg,
             model,
             parts: [Particle::default(); N],
+            exists: [false; N],
             log_w: [0.0; N],
             w: [0.0; N],
             anc: [0; N],
@@ -347,15 +476,15 @@ impl<const N: usize> CrpfTbd<N> {
     /// Step 1: `E_0^i ~ Bernoulli(P(E_0 = 1))`, `x ~ U(I_x0)` where `E = 1`, `C = 0`.
     fn init(&mut self) {
         let p0 = self.model.initial_existence;
-        for pt in self.parts.iter_mut() {
+        for (pt, flag) in self.parts.iter_mut().zip(self.exists.iter_mut()) {
             let e = self.rng.bernoulli(p0);
+            *flag = e;
             *pt = Particle {
                 x: if e {
                     self.model.prior.sample(&mut self.rng)
                 } else {
                     [0.0; 3]
                 },
-                e,
                 log_c: f32::NEG_INFINITY,
                 zh: Complex32::new(0.0, 0.0),
                 hh: 0.0,
@@ -366,43 +495,28 @@ impl<const N: usize> CrpfTbd<N> {
         self.frame = 0;
     }
 
-    /// `ln C` of a squared residual `d2`, with forgetting of the parent cost.
-    #[inline]
-    fn log_cost(&self, d2: f32, parent_log_c: f32, ln_lambda: f32) -> f32 {
-        let c = 0.5 * self.cfg.p * math::ln(d2);
-        if self.cfg.lambda > 0.0 {
-            log_add_exp(ln_lambda + parent_log_c, c)
-        } else {
-            c
-        }
-    }
-
     /// Steps (2)-(3): risks, weights, resampling. Leaves the resampled parents in
     /// `self.parts`.
     fn predict_and_resample(&mut self, z: &[Complex32], zz: f32, ln_lambda: f32) {
         let zz_floor = zz.max(f32::MIN_POSITIVE);
-        let obs = &self.model.obs;
-        let motion = &self.model.motion;
-        let prior = &self.model.prior;
         let draw = ExistenceDraw::new(&self.model.chain);
         // Squared residual of every predicted particle, and the smallest.
         let mut dmin = f32::INFINITY;
         // A local copy keeps the generator's state in registers across the loop.
         let mut rng = self.rng.clone();
-        for (pt, out) in self.parts.iter().zip(self.log_w.iter_mut()) {
-            let next = draw.next(pt.e, &mut rng);
-            *out = match (pt.e, next) {
-                (true, true) => {
-                    // Continuing.
-                    let xp = motion.predict(pt.x);
-                    obs.project_re(z, xp[0], xp[2]).residual_norm2(zz)
-                }
-                (false, true) => {
-                    // Born.
-                    let xb = prior.sample(&mut rng);
-                    obs.project_re(z, xb[0], xb[2]).residual_norm2(zz)
-                }
-                _ => zz_floor,
+        let model = &self.model;
+        for ((pt, &e), out) in self
+            .parts
+            .iter()
+            .zip(self.exists.iter())
+            .zip(self.log_w.iter_mut())
+        {
+            *out = if draw.next(e, &mut rng) {
+                let (r, d2) = risk_present(model, z, zz, &pt.x, e, rng);
+                rng = r;
+                d2
+            } else {
+                zz_floor
             };
             // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never NaN.
             if *out < dmin {
@@ -455,7 +569,8 @@ impl<const N: usize> CrpfTbd<N> {
         // Degenerate weights cannot occur (risks are floored and finite); if they did,
         // the particles are kept as they are (identity resampling).
         if ok && resample(Scheme::Systematic, &self.w, &mut self.anc, &mut self.rng).is_ok() {
-            gather_particles(&mut self.parts, &self.anc);
+            let all = self.cfg.lambda > 0.0;
+            gather_particles(&mut self.parts, &mut self.exists, &self.anc, all);
         }
     }
 
@@ -471,90 +586,59 @@ impl<const N: usize> CrpfTbd<N> {
 
         // Step (4): update existence, jitter / births, gate, costs.
         let zz_floor = zz.max(f32::MIN_POSITIVE);
-        let norm_m2 = zz + self.prev_zz;
-        let r_th = self.cfg.r_th;
-        let r_th2 = r_th * r_th;
-        let js = self.cfg.jitter_std;
+        let ctx = UpdateCtx {
+            model: &self.model,
+            cfg: &self.cfg,
+            z,
+            zz,
+            norm_m2: zz + self.prev_zz,
+            r_th2: self.cfg.r_th * self.cfg.r_th,
+            ln_free: self.int_exponent.is_some(),
+            ln_lambda,
+        };
         // `anc` (free after resampling) collects the indices of the E = 1 particles, so
         // the estimates visit only those; the min-cost one is tracked here.
         let mut count = 0usize;
         let mut best = f32::INFINITY;
         let mut arg = None;
-        let ln_free = self.int_exponent.is_some();
         let mut rng = self.rng.clone();
         let draw = ExistenceDraw::new(&self.model.chain);
-        let absent_log_c = if ln_free {
-            zz_floor
-        } else {
-            self.log_cost(zz_floor, f32::NEG_INFINITY, ln_lambda)
-        };
-        for i in 0..N {
-            let par = self.parts[i];
-            let next_e = draw.next(par.e, &mut rng);
-            let cand = match (par.e, next_e) {
-                (true, true) => {
-                    // Continuing: x ~ N(F xbar, Sigma).
-                    let xp = self.model.motion.predict(par.x);
-                    let a = xp[2] + js[2] * rng.normal();
-                    Some([
-                        self.model.motion.wrap(xp[0] + js[0] * rng.normal()),
-                        xp[1] + js[1] * rng.normal(),
-                        if a < 0.0 { -a } else { a },
-                    ])
-                }
-                (false, true) => Some(self.model.prior.sample(&mut rng)),
-                _ => None,
-            };
-            let mut next = Particle {
-                x: [0.0; 3],
-                e: false,
-                log_c: 0.0,
-                zh: Complex32::new(0.0, 0.0),
-                hh: 0.0,
-            };
-            let mut d2 = None;
-            if let Some(x) = cand {
-                let pr = self.model.obs.project(z, x[0], x[2]);
-                // Gate (eq. 10); the parent's zh, hh are 0 if it had E = 0.
-                // r >= r_th  <=>  |<m, m^i>|^2 >= r_th^2 ||m||^2 ||m^i||^2 (no sqrt).
-                let num2 = (pr.zh + par.zh).norm_sqr();
-                let den2 = norm_m2 * (pr.hh + par.hh);
-                let pass = if den2.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
-                    r_th <= 0.0 // r = 0
-                } else if num2.is_finite() && den2.is_finite() {
-                    num2 >= r_th2 * den2
-                } else {
-                    (pr.zh + par.zh).norm() / math::sqrt(den2) >= r_th
-                };
-                if pass {
-                    next = Particle {
-                        x,
-                        e: true,
-                        log_c: 0.0,
-                        zh: pr.zh,
-                        hh: pr.hh,
-                    };
-                    d2 = Some(pr.residual_norm2(zz));
+        // With lambda = 0 an absent particle's state is never read again: only its flag
+        // is written.
+        let keep_absent = self.cfg.lambda > 0.0;
+        for (i, (flag, slot)) in self
+            .exists
+            .iter_mut()
+            .zip(self.parts.iter_mut())
+            .enumerate()
+        {
+            let e = *flag;
+            if draw.next(e, &mut rng) {
+                let (r, log_c) = ctx.update_present(slot, e, rng);
+                rng = r;
+                if let Some(log_c) = log_c {
+                    *flag = true;
                     count += 1;
+                    if let Some(s) = self.anc.get_mut(count - 1) {
+                        *s = i as u32;
+                    }
+                    if log_c < best {
+                        best = log_c;
+                        arg = Some(i);
+                    }
+                    continue;
                 }
             }
-            next.log_c = match d2 {
-                Some(d2) if ln_free => d2,
-                Some(d2) => self.log_cost(d2, par.log_c, ln_lambda),
-                // E = 0: ||z||^p, the same for every absent particle when lambda = 0.
-                None if self.cfg.lambda == 0.0 => absent_log_c,
-                None => self.log_cost(zz_floor, par.log_c, ln_lambda),
-            };
-            if next.e {
-                if let Some(slot) = self.anc.get_mut(count - 1) {
-                    *slot = i as u32;
-                }
-                if next.log_c < best {
-                    best = next.log_c;
-                    arg = Some(i);
-                }
+            *flag = false;
+            if keep_absent {
+                // E = 0: x = 0, h = 0, C = lambda Cbar + ||z||^p.
+                *slot = Particle {
+                    x: [0.0; 3],
+                    log_c: log_cost(&self.cfg, zz_floor, slot.log_c, ln_lambda),
+                    zh: Complex32::new(0.0, 0.0),
+                    hh: 0.0,
+                };
             }
-            self.parts[i] = next;
         }
         self.rng = rng;
 
