@@ -49,7 +49,7 @@
 //! large instances in a `Box`, or zeroed in a `static` and set up by
 //! [`CrpfTbd::reconfigure`].
 
-use crate::math;
+use crate::math::{self, KahanSum};
 use crate::model::doppler::{check_frame, FrameDetector, Model, ModelConfig, TbdReport, MAX_BINS};
 use crate::particles::{resample, Scheme};
 use crate::rng::Rng;
@@ -147,6 +147,55 @@ struct Particle {
     zh: Complex32,
     /// `||h(x)||^2` at the particle's own frame (0 if `E = 0`).
     hh: f32,
+}
+
+/// Systematic resampling of `anc.len()` ancestors, the same result and the same single
+/// draw as [`resample`]`(Scheme::Systematic, w, anc, rng)` for weights in `[0, 1]`, in
+/// fewer passes: `sum` is the caller's compensated sum of `w` (a [`KahanSum`] in index
+/// order, what `resample` computes), the quantised weights `q_i = floor(w_i 2^31 / sum)`
+/// are computed once into `scratch` (as bits) instead of twice, and the checks of
+/// `resample` for negative or non-finite weights are not repeated (a non-finite weight
+/// makes `sum` non-finite). Returns `false`, with nothing drawn, where `resample` errs.
+fn systematic(w: &[f32], sum: f32, scratch: &mut [f32], anc: &mut [u32], rng: &mut Rng) -> bool {
+    if !(sum > 0.0 && sum.is_finite()) || w.is_empty() || w.len() != scratch.len() {
+        return false;
+    }
+    let mut scale = 2_147_483_648.0f32 / sum;
+    if !scale.is_finite() {
+        return false;
+    }
+    scale *= 1.0 - 4.0 * f32::EPSILON;
+    let mut total = 0u64;
+    for (q, &x) in scratch.iter_mut().zip(w.iter()) {
+        // As `particles::quantise`: x * scale <= 2^31 (1 + eps) fits a u32.
+        let v = (x * scale) as u32;
+        *q = f32::from_bits(v);
+        total += v as u64;
+    }
+    if total == 0 {
+        return false;
+    }
+    // Position j is (a + j T) / M; j goes to the first i with a + j T < M C_i.
+    let m = anc.len() as u64;
+    let a = (rng.next_u32() as u64 * total) >> 32;
+    let mut qs = scratch.iter().map(|q| q.to_bits() as u64);
+    let mut i = 0u32;
+    let mut cum_m = m * qs.next().unwrap_or(0);
+    let mut pos = a;
+    for slot in anc.iter_mut() {
+        while pos >= cum_m {
+            match qs.next() {
+                Some(q) => {
+                    i += 1;
+                    cum_m += m * q;
+                }
+                None => break,
+            }
+        }
+        *slot = i;
+        pos += total;
+    }
+    true
 }
 
 /// `parts[j] = old parts[anc[j]]`, `exists[j] = old exists[anc[j]]` in place for sorted
@@ -524,13 +573,39 @@ impl<const N: usize> CrpfTbd<N> {
             }
         }
         self.rng = rng;
-        let ok = if let Some(n) = self.int_exponent {
-            // w_i = (min d2 / d2_i)^(q p / 2): eq. 4 normalised by its largest weight.
-            for (w, &d) in self.w.iter_mut().zip(self.log_w.iter()) {
-                *w = powi(dmin / d, n);
+        if let Some(n) = self.int_exponent {
+            // w_i = (min d2 / d2_i)^(q p / 2): eq. 4 normalised by its largest weight,
+            // summed on the way (the compensated sum `resample` would compute).
+            let mut sum = KahanSum::new();
+            if n == 4 {
+                for (w, &d) in self.w.iter_mut().zip(self.log_w.iter()) {
+                    let r = dmin / d;
+                    let r2 = r * r;
+                    *w = r2 * r2;
+                    sum.add(*w);
+                }
+            } else {
+                for (w, &d) in self.w.iter_mut().zip(self.log_w.iter()) {
+                    *w = powi(dmin / d, n);
+                    sum.add(*w);
+                }
             }
-            true
-        } else {
+            // Degenerate weights cannot occur (risks are floored and finite, so every
+            // w_i is in [0, 1] and the best is 1); if they did, the particles are kept as
+            // they are (identity resampling), as with `resample`'s errors below.
+            if systematic(
+                &self.w,
+                sum.value(),
+                &mut self.log_w,
+                &mut self.anc,
+                &mut self.rng,
+            ) {
+                let all = self.cfg.lambda > 0.0;
+                gather_particles(&mut self.parts, &mut self.exists, &self.anc, all);
+            }
+            return;
+        }
+        let ok = {
             // ln R_i, then ln mu_i, all in the log domain.
             for (i, lr) in self.log_w.iter_mut().enumerate() {
                 let half = 0.5 * self.cfg.p * math::ln(*lr);
@@ -716,5 +791,51 @@ impl<const N: usize> FrameDetector for CrpfTbd<N> {
     fn reset(&mut self, seed: u64) {
         self.rng = Rng::seed_from_u64(seed);
         self.init();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::vec::Vec;
+
+    #[test]
+    fn fused_systematic_equals_resample() {
+        // Weights like CRPF's: many equal (absent particles), a few larger, exact zeros.
+        let mut rng = Rng::seed_from_u64(11);
+        for n in [1usize, 2, 7, 64, 1000, 6000] {
+            for trial in 0..20 {
+                let w: Vec<f32> = (0..n)
+                    .map(|i| match (i + trial) % 5 {
+                        0 => rng.uniform(),
+                        1 => 0.0,
+                        _ => 1e-3 * (1 + trial % 3) as f32,
+                    })
+                    .collect();
+                let mut sum = KahanSum::new();
+                for &x in &w {
+                    sum.add(x);
+                }
+                let mut a = std::vec![0u32; n];
+                let mut b = std::vec![0u32; n];
+                let mut scratch = std::vec![0.0f32; n];
+                let mut r1 = rng.clone();
+                let mut r2 = rng.clone();
+                let ok1 = resample(Scheme::Systematic, &w, &mut a, &mut r1).is_ok();
+                let ok2 = systematic(&w, sum.value(), &mut scratch, &mut b, &mut r2);
+                assert_eq!(ok1, ok2, "n {n} trial {trial}");
+                if ok1 {
+                    assert_eq!(a, b, "n {n} trial {trial}");
+                }
+                assert_eq!(r1, r2);
+                rng.next_u32();
+            }
+        }
+        // All zero: both refuse, nothing drawn.
+        let w = [0.0f32; 4];
+        let mut r = Rng::seed_from_u64(1);
+        let before = r.clone();
+        assert!(!systematic(&w, 0.0, &mut [0.0; 4], &mut [0; 4], &mut r));
+        assert_eq!(r, before);
     }
 }
