@@ -175,25 +175,27 @@ fn systematic(w: &[f32], sum: f32, scratch: &mut [f32], anc: &mut [u32], rng: &m
     if total == 0 {
         return false;
     }
-    // Position j is (a + j T) / M; j goes to the first i with a + j T < M C_i.
+    // Position j is (a + j T) / M; j goes to the first i with a + j T < M C_i. The walk
+    // keeps `gap = M C_i - (a + j T)` (exact in i64: both terms are below 2^45 for
+    // M < 2^13, and below 2^63 for any M < 2^31) and advances i while `gap <= 0`.
     let m = anc.len() as u64;
     let a = (rng.next_u32() as u64 * total) >> 32;
     let mut qs = scratch.iter().map(|q| q.to_bits() as u64);
     let mut i = 0u32;
-    let mut cum_m = m * qs.next().unwrap_or(0);
-    let mut pos = a;
+    let mut gap = (m * qs.next().unwrap_or(0)) as i64 - a as i64;
+    let step = total as i64;
     for slot in anc.iter_mut() {
-        while pos >= cum_m {
+        while gap <= 0 {
             match qs.next() {
                 Some(q) => {
                     i += 1;
-                    cum_m += m * q;
+                    gap += (m * q) as i64;
                 }
                 None => break,
             }
         }
         *slot = i;
-        pos += total;
+        gap -= step;
     }
     true
 }
@@ -224,7 +226,10 @@ fn gather_particles(parts: &mut [Particle], exists: &mut [bool], anc: &[u32], al
                 d.x[0] = x[0];
                 d.x[1] = x[1];
                 d.x[2] = x[2];
-                d.log_c = log_c;
+                if all {
+                    // The parent cost is read only when lambda > 0.
+                    d.log_c = log_c;
+                }
                 d.zh.re = zh.re;
                 d.zh.im = zh.im;
                 d.hh = hh;
