@@ -254,10 +254,8 @@ fn gather_particles(parts: &mut [Particle], exists: &mut [bool], anc: &[u32], al
 /// `f32`, so `u < p` is `(x >> 8) < ceil(p 2^24)` for the whole number `x >> 8`.
 #[derive(Debug, Clone, Copy)]
 struct ExistenceDraw {
-    /// `ceil(Pb 2^24)`.
-    birth: u32,
-    /// `ceil(Pd 2^24)`.
-    death: u32,
+    /// `[ceil(Pb 2^24), ceil(Pd 2^24)]`, indexed by `E_{k-1}`.
+    thr: [u32; 2],
 }
 
 impl ExistenceDraw {
@@ -273,8 +271,7 @@ impl ExistenceDraw {
             }
         };
         Self {
-            birth: ceil(chain.birth()),
-            death: ceil(chain.death()),
+            thr: [ceil(chain.birth()), ceil(chain.death())],
         }
     }
 
@@ -283,7 +280,7 @@ impl ExistenceDraw {
     #[inline(always)]
     fn next(&self, existed: bool, rng: &mut Rng) -> bool {
         let u = rng.next_u32() >> 8;
-        let thr = if existed { self.death } else { self.birth };
+        let thr = self.thr[existed as usize];
         existed != (u < thr)
     }
 }
@@ -450,6 +447,51 @@ fn risk_present(
     (rng, d2)
 }
 
+/// Step (2): the existence draw and the squared residual `||z - h||^2` of every
+/// predicted particle into `out` (`||z||^2`, floored, for `E = 0`); returns the smallest.
+/// Its own function so that the loop over mostly absent particles keeps the generator
+/// and its pointers in registers.
+#[inline(never)]
+fn risk_pass(
+    model: &Model,
+    z: &[Complex32],
+    zz: f32,
+    exists: &[bool],
+    parts: &[Particle],
+    out: &mut [f32],
+    rng_out: &mut Rng,
+) -> f32 {
+    let zz_floor = zz.max(f32::MIN_POSITIVE);
+    let draw = ExistenceDraw::new(&model.chain);
+    let mut rng = rng_out.clone();
+    let mut dmin = f32::INFINITY;
+    let mut n_absent = 0u32;
+    for (i, (&e, o)) in exists.iter().zip(out.iter_mut()).enumerate() {
+        if draw.next(e, &mut rng) {
+            let x = match parts.get(i) {
+                Some(p) => &p.x,
+                None => break,
+            };
+            let (r, d2) = risk_present(model, z, zz, x, e, rng);
+            rng = r;
+            *o = d2;
+            // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never
+            // NaN.
+            if d2 < dmin {
+                dmin = d2;
+            }
+        } else {
+            *o = zz_floor;
+            n_absent += 1;
+        }
+    }
+    if n_absent > 0 && zz_floor < dmin {
+        dmin = zz_floor;
+    }
+    *rng_out = rng;
+    dmin
+}
+
 /// CRPF-TBD with `N` particles.
 #[derive(Debug, Clone)]
 pub struct CrpfTbd<const N: usize> {
@@ -552,32 +594,16 @@ impl<const N: usize> CrpfTbd<N> {
     /// Steps (2)-(3): risks, weights, resampling. Leaves the resampled parents in
     /// `self.parts`.
     fn predict_and_resample(&mut self, z: &[Complex32], zz: f32, ln_lambda: f32) {
-        let zz_floor = zz.max(f32::MIN_POSITIVE);
-        let draw = ExistenceDraw::new(&self.model.chain);
         // Squared residual of every predicted particle, and the smallest.
-        let mut dmin = f32::INFINITY;
-        // A local copy keeps the generator's state in registers across the loop.
-        let mut rng = self.rng.clone();
-        let model = &self.model;
-        for ((pt, &e), out) in self
-            .parts
-            .iter()
-            .zip(self.exists.iter())
-            .zip(self.log_w.iter_mut())
-        {
-            *out = if draw.next(e, &mut rng) {
-                let (r, d2) = risk_present(model, z, zz, &pt.x, e, rng);
-                rng = r;
-                d2
-            } else {
-                zz_floor
-            };
-            // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never NaN.
-            if *out < dmin {
-                dmin = *out;
-            }
-        }
-        self.rng = rng;
+        let dmin = risk_pass(
+            &self.model,
+            z,
+            zz,
+            &self.exists,
+            &self.parts,
+            &mut self.log_w,
+            &mut self.rng,
+        );
         if let Some(n) = self.int_exponent {
             // w_i = (min d2 / d2_i)^(q p / 2): eq. 4 normalised by its largest weight,
             // summed on the way (the compensated sum `resample` would compute).
@@ -686,14 +712,12 @@ impl<const N: usize> CrpfTbd<N> {
         // With lambda = 0 an absent particle's state is never read again: only its flag
         // is written.
         let keep_absent = self.cfg.lambda > 0.0;
-        for (i, (flag, slot)) in self
-            .exists
-            .iter_mut()
-            .zip(self.parts.iter_mut())
-            .enumerate()
-        {
+        for (i, flag) in self.exists.iter_mut().enumerate() {
             let e = *flag;
             if draw.next(e, &mut rng) {
+                let Some(slot) = self.parts.get_mut(i) else {
+                    break;
+                };
                 let (r, log_c) = ctx.update_present(slot, e, rng);
                 rng = r;
                 if let Some(log_c) = log_c {
@@ -711,13 +735,15 @@ impl<const N: usize> CrpfTbd<N> {
             }
             *flag = false;
             if keep_absent {
-                // E = 0: x = 0, h = 0, C = lambda Cbar + ||z||^p.
-                *slot = Particle {
-                    x: [0.0; 3],
-                    log_c: log_cost(&self.cfg, zz_floor, slot.log_c, ln_lambda),
-                    zh: Complex32::new(0.0, 0.0),
-                    hh: 0.0,
-                };
+                if let Some(slot) = self.parts.get_mut(i) {
+                    // E = 0: x = 0, h = 0, C = lambda Cbar + ||z||^p.
+                    *slot = Particle {
+                        x: [0.0; 3],
+                        log_c: log_cost(&self.cfg, zz_floor, slot.log_c, ln_lambda),
+                        zh: Complex32::new(0.0, 0.0),
+                        hh: 0.0,
+                    };
+                }
             }
         }
         self.rng = rng;
