@@ -44,8 +44,9 @@
 //!   frames are zero, and then rejects (`r = 0`).
 //! - `P(E_0 = 1)` is [`ModelConfig::initial_existence`](crate::model::doppler::ModelConfig).
 //!
-//! Memory: `N * 32` bytes of particles plus `N * 12` bytes of weights and ancestors
-//! and an 11 KB fixed part, mostly the response table (about 275 KB at `N = 6000`): build
+//! Memory: `N * 29` bytes of particles (28 B state, 1 B existence flag) plus `N * 12`
+//! bytes of weights and ancestors and an 11 KB fixed part, mostly the response table
+//! (about 257 KB at `N = 6000`): build
 //! large instances in a `Box`, or zeroed in a `static` and set up by
 //! [`CrpfTbd::reconfigure`].
 
