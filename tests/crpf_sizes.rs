@@ -1,6 +1,6 @@
 //! Static RAM of each detector configuration (`size_of`), against the per-particle
-//! budget the docs state: CRPF-TBD 44 B/particle (32 B particle + 4 B log weight + 4 B
-//! weight + 4 B ancestor), PF-TBD 28 B (16 + 12), JOTT and PF-LRT 24 B (12 + 12), plus a
+//! budget the docs state: CRPF-TBD 41 B/particle (28 B particle state + 1 B existence
+//! flag + 4 B log weight + 4 B weight + 4 B ancestor), PF-TBD 28 B (16 + 12), JOTT and PF-LRT 24 B (12 + 12), plus a
 //! fixed part under 11 KB (the response table as 128 interpolation rows of 5 bins x 4
 //! f32, 10 KB, and the previous frame).
 
@@ -21,8 +21,8 @@ fn check(name: &str, n: usize, size: usize, per: usize) {
 
 #[test]
 fn static_ram_per_configuration() {
-    check("CRPF-TBD", 1000, size_of::<CrpfTbd<1000>>(), 44);
-    check("CRPF-TBD", 6000, size_of::<CrpfTbd<6000>>(), 44);
+    check("CRPF-TBD", 1000, size_of::<CrpfTbd<1000>>(), 41);
+    check("CRPF-TBD", 6000, size_of::<CrpfTbd<6000>>(), 41);
     check("PF-TBD", 1000, size_of::<PfTbd<1000>>(), 28);
     check("PF-TBD", 6000, size_of::<PfTbd<6000>>(), 28);
     check("JOTT", 1000, size_of::<BernoulliTbd<1000>>(), 24);

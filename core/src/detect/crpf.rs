@@ -44,13 +44,13 @@
 //!   frames are zero, and then rejects (`r = 0`).
 //! - `P(E_0 = 1)` is [`ModelConfig::initial_existence`](crate::model::doppler::ModelConfig).
 //!
-//! Memory: `N * 32` bytes of particles plus `N * 12` bytes of weights and ancestors
-//! and an 11 KB fixed part, mostly the response table (about 275 KB at `N = 6000`): build
+//! Memory: `N * 29` bytes of particles (28 B state, 1 B existence flag) plus `N * 12`
+//! bytes of weights and ancestors and an 11 KB fixed part, mostly the response table
+//! (about 257 KB at `N = 6000`): build
 //! large instances in a `Box`, or zeroed in a `static` and set up by
 //! [`CrpfTbd::reconfigure`].
 
-use crate::existence::Transition;
-use crate::math;
+use crate::math::{self, KahanSum};
 use crate::model::doppler::{check_frame, FrameDetector, Model, ModelConfig, TbdReport, MAX_BINS};
 use crate::particles::{resample, Scheme};
 use crate::rng::Rng;
@@ -134,11 +134,13 @@ impl CrpfConfig {
     }
 }
 
-/// One CRPF-TBD particle.
+/// The state of one CRPF-TBD particle; its existence flag `E` lives in a separate array
+/// ([`CrpfTbd`] keeps structure-of-arrays flags), so that an absent particle costs one
+/// byte to move. When `lambda = 0` every `E = 0` particle has `x = 0`, `h = 0` and the
+/// same cost, so its `Particle` is never read and is left stale (not written at all).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 struct Particle {
     x: [f32; 3],
-    e: bool,
     /// `ln C` (`-inf` for `C = 0`); on the ln-free path (`int_exponent`), the squared
     /// residual `d2 = C^(2/p)` instead (0 before the first frame).
     log_c: f32,
@@ -148,21 +150,87 @@ struct Particle {
     hh: f32,
 }
 
-/// `parts[j] = old parts[anc[j]]` in place for sorted ancestors (what
-/// [`resample`] produces), like [`gather_in_place`](crate::particles::gather_in_place) but copying field by field: a
+/// Systematic resampling of `anc.len()` ancestors, the same result and the same single
+/// draw as [`resample`]`(Scheme::Systematic, w, anc, rng)` for weights in `[0, 1]`, in
+/// fewer passes: `sum` is the caller's compensated sum of `w` (a [`KahanSum`] in index
+/// order, what `resample` computes), the quantised weights `q_i = floor(w_i 2^31 / sum)`
+/// are computed once into `scratch` (as bits) instead of twice, and the checks of
+/// `resample` for negative or non-finite weights are not repeated (a non-finite weight
+/// makes `sum` non-finite). Returns `false`, with nothing drawn, where `resample` errs.
+fn systematic(w: &[f32], sum: f32, scratch: &mut [f32], anc: &mut [u32], rng: &mut Rng) -> bool {
+    if !(sum > 0.0 && sum.is_finite()) || w.is_empty() || w.len() != scratch.len() {
+        return false;
+    }
+    let mut scale = 2_147_483_648.0f32 / sum;
+    if !scale.is_finite() {
+        return false;
+    }
+    scale *= 1.0 - 4.0 * f32::EPSILON;
+    let mut total = 0u64;
+    for (q, &x) in scratch.iter_mut().zip(w.iter()) {
+        // As `particles::quantise`: x * scale <= 2^31 (1 + eps) fits a u32.
+        let v = (x * scale) as u32;
+        *q = f32::from_bits(v);
+        total += v as u64;
+    }
+    if total == 0 {
+        return false;
+    }
+    // Position j is (a + j T) / M; j goes to the first i with a + j T < M C_i. The walk
+    // keeps `gap = M C_i - (a + j T)` (exact in i64: both terms are below 2^45 for
+    // M < 2^13, and below 2^63 for any M < 2^31) and advances i while `gap <= 0`.
+    let m = anc.len() as u64;
+    let a = (rng.next_u32() as u64 * total) >> 32;
+    let mut qs = scratch.iter().map(|q| q.to_bits() as u64);
+    let mut i = 0u32;
+    let mut gap = (m * qs.next().unwrap_or(0)) as i64 - a as i64;
+    let step = total as i64;
+    for slot in anc.iter_mut() {
+        while gap <= 0 {
+            match qs.next() {
+                Some(q) => {
+                    i += 1;
+                    gap += (m * q) as i64;
+                }
+                None => break,
+            }
+        }
+        *slot = i;
+        gap -= step;
+    }
+    true
+}
+
+/// `parts[j] = old parts[anc[j]]`, `exists[j] = old exists[anc[j]]` in place for sorted
+/// ancestors (what [`resample`] produces), like
+/// [`gather_in_place`](crate::particles::gather_in_place) but copying field by field (a
 /// whole-struct copy inside one slice compiles to a `memmove` call per particle on the
-/// M4. Same two passes (ascending for `a > j`, descending for `a < j`).
-fn gather_particles(parts: &mut [Particle], anc: &[u32]) {
+/// M4) and, unless `all`, copying the state only of `E = 1` particles (with `lambda = 0`
+/// an absent particle's state is never read). Same two passes (ascending for `a > j`,
+/// descending for `a < j`).
+fn gather_particles(parts: &mut [Particle], exists: &mut [bool], anc: &[u32], all: bool) {
     #[inline(always)]
-    fn copy(parts: &mut [Particle], j: usize, a: usize) {
+    fn copy(parts: &mut [Particle], exists: &mut [bool], j: usize, a: usize, all: bool) {
+        let e = match exists.get(a) {
+            Some(&e) => e,
+            None => return,
+        };
+        if let Some(d) = exists.get_mut(j) {
+            *d = e;
+        }
+        if !(e || all) {
+            return;
+        }
         if let Some(&s) = parts.get(a) {
-            let (x, e, log_c, zh, hh) = (s.x, s.e, s.log_c, s.zh, s.hh);
+            let (x, log_c, zh, hh) = (s.x, s.log_c, s.zh, s.hh);
             if let Some(d) = parts.get_mut(j) {
                 d.x[0] = x[0];
                 d.x[1] = x[1];
                 d.x[2] = x[2];
-                d.e = e;
-                d.log_c = log_c;
+                if all {
+                    // The parent cost is read only when lambda > 0.
+                    d.log_c = log_c;
+                }
                 d.zh.re = zh.re;
                 d.zh.im = zh.im;
                 d.hh = hh;
@@ -171,13 +239,50 @@ fn gather_particles(parts: &mut [Particle], anc: &[u32]) {
     }
     for (j, &a) in anc.iter().enumerate() {
         if a as usize > j {
-            copy(parts, j, a as usize);
+            copy(parts, exists, j, a as usize, all);
         }
     }
     for (j, &a) in anc.iter().enumerate().rev() {
         if (a as usize) < j {
-            copy(parts, j, a as usize);
+            copy(parts, exists, j, a as usize, all);
         }
+    }
+}
+
+/// The existence draw of eq. 9 in integers, bit-identical to
+/// [`ExistenceMarkov::sample`](crate::existence::ExistenceMarkov::sample): that draws
+/// `u = (x >> 8) 2^-24` from one `u32` `x` and compares `u < p`; `p 2^24` is exact in
+/// `f32`, so `u < p` is `(x >> 8) < ceil(p 2^24)` for the whole number `x >> 8`.
+#[derive(Debug, Clone, Copy)]
+struct ExistenceDraw {
+    /// `[ceil(Pb 2^24), ceil(Pd 2^24)]`, indexed by `E_{k-1}`.
+    thr: [u32; 2],
+}
+
+impl ExistenceDraw {
+    fn new(chain: &crate::existence::ExistenceMarkov) -> Self {
+        // p in [0, 1] (validated by the chain), so p 2^24 in [0, 2^24] is exact.
+        let ceil = |p: f32| {
+            let t = p * 16_777_216.0;
+            let f = t as u32;
+            if (f as f32) < t {
+                f + 1
+            } else {
+                f
+            }
+        };
+        Self {
+            thr: [ceil(chain.birth()), ceil(chain.death())],
+        }
+    }
+
+    /// `E_k` given `E_{k-1} = existed`, from one draw: the flag flips (birth or death)
+    /// when the draw falls below the row's threshold.
+    #[inline(always)]
+    fn next(&self, existed: bool, rng: &mut Rng) -> bool {
+        let u = rng.next_u32() >> 8;
+        let thr = self.thr[existed as usize];
+        existed != (u < thr)
     }
 }
 
@@ -189,6 +294,17 @@ fn log_add_exp(a: f32, b: f32) -> f32 {
         return hi;
     }
     hi + math::ln1p(math::exp(lo - hi))
+}
+
+/// `ln C` of a squared residual `d2`, with forgetting of the parent cost (eq. 11).
+#[inline]
+fn log_cost(cfg: &CrpfConfig, d2: f32, parent_log_c: f32, ln_lambda: f32) -> f32 {
+    let c = 0.5 * cfg.p * math::ln(d2);
+    if cfg.lambda > 0.0 {
+        log_add_exp(ln_lambda + parent_log_c, c)
+    } else {
+        c
+    }
 }
 
 /// `x^n` for a small whole `n >= 1` by repeated squaring.
@@ -231,12 +347,160 @@ fn int_exponent(cfg: &CrpfConfig) -> Option<u32> {
     }
 }
 
+/// What step (4) needs for one particle that exists after the existence draw.
+struct UpdateCtx<'a> {
+    model: &'a Model,
+    cfg: &'a CrpfConfig,
+    z: &'a [Complex32],
+    zz: f32,
+    /// `||m_k||^2 = ||z_k||^2 + ||z_{k-1}||^2`.
+    norm_m2: f32,
+    r_th2: f32,
+    ln_free: bool,
+    ln_lambda: f32,
+}
+
+impl UpdateCtx<'_> {
+    /// Step (4) for a particle with `E_k = 1`: jitter `x ~ N(F xbar, Sigma)` if it
+    /// continues (`existed`), a birth from `U(I_x0)` otherwise, then the gate (eq. 10)
+    /// and the cost. On a pass writes the new state into `slot` and returns its cost;
+    /// on a rejection leaves `slot` untouched. Out of line, with the generator by value,
+    /// so that the loop over mostly absent particles keeps its state in registers.
+    #[inline(never)]
+    fn update_present(
+        &self,
+        slot: &mut Particle,
+        existed: bool,
+        mut rng: Rng,
+    ) -> (Rng, Option<f32>) {
+        let par = *slot;
+        let motion = &self.model.motion;
+        let js = self.cfg.jitter_std;
+        let (x, par_zh, par_hh) = if existed {
+            let xp = motion.predict(par.x);
+            let a = xp[2] + js[2] * rng.normal();
+            (
+                [
+                    motion.wrap(xp[0] + js[0] * rng.normal()),
+                    xp[1] + js[1] * rng.normal(),
+                    if a < 0.0 { -a } else { a },
+                ],
+                par.zh,
+                par.hh,
+            )
+        } else {
+            // Born: the parent had E = 0, so its zh, hh are 0.
+            (
+                self.model.prior.sample(&mut rng),
+                Complex32::new(0.0, 0.0),
+                0.0,
+            )
+        };
+        let pr = self.model.obs.project(self.z, x[0], x[2]);
+        // Gate (eq. 10). r >= r_th  <=>  |<m, m^i>|^2 >= r_th^2 ||m||^2 ||m^i||^2 (no sqrt).
+        let r_th = self.cfg.r_th;
+        let num2 = (pr.zh + par_zh).norm_sqr();
+        let den2 = self.norm_m2 * (pr.hh + par_hh);
+        let pass = if den2.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
+            r_th <= 0.0 // r = 0
+        } else if num2.is_finite() && den2.is_finite() {
+            num2 >= self.r_th2 * den2
+        } else {
+            (pr.zh + par_zh).norm() / math::sqrt(den2) >= r_th
+        };
+        if !pass {
+            return (rng, None);
+        }
+        let d2 = pr.residual_norm2(self.zz);
+        let log_c = if self.ln_free {
+            d2
+        } else {
+            log_cost(self.cfg, d2, par.log_c, self.ln_lambda)
+        };
+        *slot = Particle {
+            x,
+            log_c,
+            zh: pr.zh,
+            hh: pr.hh,
+        };
+        (rng, Some(log_c))
+    }
+}
+
+/// Step (2) for a particle with `E_k = 1` in the prediction: `||z - h(x)||^2` of `F x`
+/// (`existed`) or of a birth from `U(I_x0)`. Out of line, generator by value (see
+/// [`UpdateCtx::update_present`]).
+#[inline(never)]
+fn risk_present(
+    model: &Model,
+    z: &[Complex32],
+    zz: f32,
+    x: &[f32; 3],
+    existed: bool,
+    mut rng: Rng,
+) -> (Rng, f32) {
+    let xp = if existed {
+        model.motion.predict(*x)
+    } else {
+        model.prior.sample(&mut rng)
+    };
+    let d2 = model.obs.project_re(z, xp[0], xp[2]).residual_norm2(zz);
+    (rng, d2)
+}
+
+/// Step (2): the existence draw and the squared residual `||z - h||^2` of every
+/// predicted particle into `out` (`||z||^2`, floored, for `E = 0`); returns the smallest.
+/// Its own function so that the loop over mostly absent particles keeps the generator
+/// and its pointers in registers.
+#[inline(never)]
+fn risk_pass(
+    model: &Model,
+    z: &[Complex32],
+    zz: f32,
+    exists: &[bool],
+    parts: &[Particle],
+    out: &mut [f32],
+    rng_out: &mut Rng,
+) -> f32 {
+    let zz_floor = zz.max(f32::MIN_POSITIVE);
+    let draw = ExistenceDraw::new(&model.chain);
+    let mut rng = rng_out.clone();
+    let mut dmin = f32::INFINITY;
+    let mut n_absent = 0u32;
+    for (i, (&e, o)) in exists.iter().zip(out.iter_mut()).enumerate() {
+        if draw.next(e, &mut rng) {
+            let x = match parts.get(i) {
+                Some(p) => &p.x,
+                None => break,
+            };
+            let (r, d2) = risk_present(model, z, zz, x, e, rng);
+            rng = r;
+            *o = d2;
+            // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never
+            // NaN.
+            if d2 < dmin {
+                dmin = d2;
+            }
+        } else {
+            *o = zz_floor;
+            n_absent += 1;
+        }
+    }
+    if n_absent > 0 && zz_floor < dmin {
+        dmin = zz_floor;
+    }
+    *rng_out = rng;
+    dmin
+}
+
 /// CRPF-TBD with `N` particles.
 #[derive(Debug, Clone)]
 pub struct CrpfTbd<const N: usize> {
     cfg: CrpfConfig,
     model: Model,
     parts: [Particle; N],
+    /// `E` of each particle.
+    exists: [bool; N],
     /// Log risks, then log weights; reused as scratch.
     log_w: [f32; N],
     w: [f32; N],
@@ -264,6 +528,7 @@ impl<const N: usize> CrpfTbd<N> {
             cfg,
             model,
             parts: [Particle::default(); N],
+            exists: [false; N],
             log_w: [0.0; N],
             w: [0.0; N],
             anc: [0; N],
@@ -308,15 +573,15 @@ impl<const N: usize> CrpfTbd<N> {
     /// Step 1: `E_0^i ~ Bernoulli(P(E_0 = 1))`, `x ~ U(I_x0)` where `E = 1`, `C = 0`.
     fn init(&mut self) {
         let p0 = self.model.initial_existence;
-        for pt in self.parts.iter_mut() {
+        for (pt, flag) in self.parts.iter_mut().zip(self.exists.iter_mut()) {
             let e = self.rng.bernoulli(p0);
+            *flag = e;
             *pt = Particle {
                 x: if e {
                     self.model.prior.sample(&mut self.rng)
                 } else {
                     [0.0; 3]
                 },
-                e,
                 log_c: f32::NEG_INFINITY,
                 zh: Complex32::new(0.0, 0.0),
                 hh: 0.0,
@@ -327,55 +592,52 @@ impl<const N: usize> CrpfTbd<N> {
         self.frame = 0;
     }
 
-    /// `ln C` of a squared residual `d2`, with forgetting of the parent cost.
-    #[inline]
-    fn log_cost(&self, d2: f32, parent_log_c: f32, ln_lambda: f32) -> f32 {
-        let c = 0.5 * self.cfg.p * math::ln(d2);
-        if self.cfg.lambda > 0.0 {
-            log_add_exp(ln_lambda + parent_log_c, c)
-        } else {
-            c
-        }
-    }
-
     /// Steps (2)-(3): risks, weights, resampling. Leaves the resampled parents in
     /// `self.parts`.
     fn predict_and_resample(&mut self, z: &[Complex32], zz: f32, ln_lambda: f32) {
-        let zz_floor = zz.max(f32::MIN_POSITIVE);
-        let obs = &self.model.obs;
-        let motion = &self.model.motion;
-        let prior = &self.model.prior;
-        let chain = &self.model.chain;
         // Squared residual of every predicted particle, and the smallest.
-        let mut dmin = f32::INFINITY;
-        // A local copy keeps the generator's state in registers across the loop.
-        let mut rng = self.rng.clone();
-        for (pt, out) in self.parts.iter().zip(self.log_w.iter_mut()) {
-            let t = chain.sample(pt.e, &mut rng);
-            *out = match t {
-                Transition::Continuing => {
-                    let xp = motion.predict(pt.x);
-                    obs.project_re(z, xp[0], xp[2]).residual_norm2(zz)
+        let dmin = risk_pass(
+            &self.model,
+            z,
+            zz,
+            &self.exists,
+            &self.parts,
+            &mut self.log_w,
+            &mut self.rng,
+        );
+        if let Some(n) = self.int_exponent {
+            // w_i = (min d2 / d2_i)^(q p / 2): eq. 4 normalised by its largest weight,
+            // summed on the way (the compensated sum `resample` would compute).
+            let mut sum = KahanSum::new();
+            if n == 4 {
+                for (w, &d) in self.w.iter_mut().zip(self.log_w.iter()) {
+                    let r = dmin / d;
+                    let r2 = r * r;
+                    *w = r2 * r2;
+                    sum.add(*w);
                 }
-                Transition::Born => {
-                    let xb = prior.sample(&mut rng);
-                    obs.project_re(z, xb[0], xb[2]).residual_norm2(zz)
+            } else {
+                for (w, &d) in self.w.iter_mut().zip(self.log_w.iter()) {
+                    *w = powi(dmin / d, n);
+                    sum.add(*w);
                 }
-                _ => zz_floor,
-            };
-            // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never NaN.
-            if *out < dmin {
-                dmin = *out;
             }
+            // Degenerate weights cannot occur (risks are floored and finite, so every
+            // w_i is in [0, 1] and the best is 1); if they did, the particles are kept as
+            // they are (identity resampling), as with `resample`'s errors below.
+            if systematic(
+                &self.w,
+                sum.value(),
+                &mut self.log_w,
+                &mut self.anc,
+                &mut self.rng,
+            ) {
+                let all = self.cfg.lambda > 0.0;
+                gather_particles(&mut self.parts, &mut self.exists, &self.anc, all);
+            }
+            return;
         }
-        self.rng = rng;
-        let ok = if let Some(n) = self.int_exponent {
-            // w_i = (min d2 / d2_i)^(q p / 2): eq. 4 normalised by its largest weight.
-            for (w, &d) in self.w.iter_mut().zip(self.log_w.iter()) {
-                *w = powi(dmin / d, n);
-            }
-            true
-        } else {
+        let ok = {
             // ln R_i, then ln mu_i, all in the log domain.
             for (i, lr) in self.log_w.iter_mut().enumerate() {
                 let half = 0.5 * self.cfg.p * math::ln(*lr);
@@ -414,7 +676,8 @@ impl<const N: usize> CrpfTbd<N> {
         // Degenerate weights cannot occur (risks are floored and finite); if they did,
         // the particles are kept as they are (identity resampling).
         if ok && resample(Scheme::Systematic, &self.w, &mut self.anc, &mut self.rng).is_ok() {
-            gather_particles(&mut self.parts, &self.anc);
+            let all = self.cfg.lambda > 0.0;
+            gather_particles(&mut self.parts, &mut self.exists, &self.anc, all);
         }
     }
 
@@ -430,88 +693,59 @@ impl<const N: usize> CrpfTbd<N> {
 
         // Step (4): update existence, jitter / births, gate, costs.
         let zz_floor = zz.max(f32::MIN_POSITIVE);
-        let norm_m2 = zz + self.prev_zz;
-        let r_th = self.cfg.r_th;
-        let r_th2 = r_th * r_th;
-        let js = self.cfg.jitter_std;
+        let ctx = UpdateCtx {
+            model: &self.model,
+            cfg: &self.cfg,
+            z,
+            zz,
+            norm_m2: zz + self.prev_zz,
+            r_th2: self.cfg.r_th * self.cfg.r_th,
+            ln_free: self.int_exponent.is_some(),
+            ln_lambda,
+        };
         // `anc` (free after resampling) collects the indices of the E = 1 particles, so
         // the estimates visit only those; the min-cost one is tracked here.
         let mut count = 0usize;
         let mut best = f32::INFINITY;
         let mut arg = None;
-        let ln_free = self.int_exponent.is_some();
         let mut rng = self.rng.clone();
-        let absent_log_c = if ln_free {
-            zz_floor
-        } else {
-            self.log_cost(zz_floor, f32::NEG_INFINITY, ln_lambda)
-        };
-        for i in 0..N {
-            let par = self.parts[i];
-            let t = self.model.chain.sample(par.e, &mut rng);
-            let cand = match t {
-                Transition::Continuing => {
-                    let xp = self.model.motion.predict(par.x);
-                    let a = xp[2] + js[2] * rng.normal();
-                    Some([
-                        self.model.motion.wrap(xp[0] + js[0] * rng.normal()),
-                        xp[1] + js[1] * rng.normal(),
-                        if a < 0.0 { -a } else { a },
-                    ])
-                }
-                Transition::Born => Some(self.model.prior.sample(&mut rng)),
-                _ => None,
-            };
-            let mut next = Particle {
-                x: [0.0; 3],
-                e: false,
-                log_c: 0.0,
-                zh: Complex32::new(0.0, 0.0),
-                hh: 0.0,
-            };
-            let mut d2 = None;
-            if let Some(x) = cand {
-                let pr = self.model.obs.project(z, x[0], x[2]);
-                // Gate (eq. 10); the parent's zh, hh are 0 if it had E = 0.
-                // r >= r_th  <=>  |<m, m^i>|^2 >= r_th^2 ||m||^2 ||m^i||^2 (no sqrt).
-                let num2 = (pr.zh + par.zh).norm_sqr();
-                let den2 = norm_m2 * (pr.hh + par.hh);
-                let pass = if den2.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
-                    r_th <= 0.0 // r = 0
-                } else if num2.is_finite() && den2.is_finite() {
-                    num2 >= r_th2 * den2
-                } else {
-                    (pr.zh + par.zh).norm() / math::sqrt(den2) >= r_th
+        let draw = ExistenceDraw::new(&self.model.chain);
+        // With lambda = 0 an absent particle's state is never read again: only its flag
+        // is written.
+        let keep_absent = self.cfg.lambda > 0.0;
+        for (i, flag) in self.exists.iter_mut().enumerate() {
+            let e = *flag;
+            if draw.next(e, &mut rng) {
+                let Some(slot) = self.parts.get_mut(i) else {
+                    break;
                 };
-                if pass {
-                    next = Particle {
-                        x,
-                        e: true,
-                        log_c: 0.0,
-                        zh: pr.zh,
-                        hh: pr.hh,
-                    };
-                    d2 = Some(pr.residual_norm2(zz));
+                let (r, log_c) = ctx.update_present(slot, e, rng);
+                rng = r;
+                if let Some(log_c) = log_c {
+                    *flag = true;
                     count += 1;
+                    if let Some(s) = self.anc.get_mut(count - 1) {
+                        *s = i as u32;
+                    }
+                    if log_c < best {
+                        best = log_c;
+                        arg = Some(i);
+                    }
+                    continue;
                 }
             }
-            next.log_c = match d2 {
-                Some(d2) if ln_free => d2,
-                Some(d2) => self.log_cost(d2, par.log_c, ln_lambda),
-                // E = 0: ||z||^p, the same for every absent particle when lambda = 0.
-                None if self.cfg.lambda == 0.0 => absent_log_c,
-                None => self.log_cost(zz_floor, par.log_c, ln_lambda),
-            };
-            if next.e {
-                if let Some(slot) = self.anc.get_mut(count - 1) {
-                    *slot = i as u32;
-                }
-                if next.log_c < best {
-                    best = next.log_c;
-                    arg = Some(i);
+            *flag = false;
+            if keep_absent {
+                if let Some(slot) = self.parts.get_mut(i) {
+                    // E = 0: x = 0, h = 0, C = lambda Cbar + ||z||^p.
+                    *slot = Particle {
+                        x: [0.0; 3],
+                        log_c: log_cost(&self.cfg, zz_floor, slot.log_c, ln_lambda),
+                        zh: Complex32::new(0.0, 0.0),
+                        hh: 0.0,
+                    };
                 }
             }
-            self.parts[i] = next;
         }
         self.rng = rng;
 
@@ -589,5 +823,51 @@ impl<const N: usize> FrameDetector for CrpfTbd<N> {
     fn reset(&mut self, seed: u64) {
         self.rng = Rng::seed_from_u64(seed);
         self.init();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::vec::Vec;
+
+    #[test]
+    fn fused_systematic_equals_resample() {
+        // Weights like CRPF's: many equal (absent particles), a few larger, exact zeros.
+        let mut rng = Rng::seed_from_u64(11);
+        for n in [1usize, 2, 7, 64, 1000, 6000] {
+            for trial in 0..20 {
+                let w: Vec<f32> = (0..n)
+                    .map(|i| match (i + trial) % 5 {
+                        0 => rng.uniform(),
+                        1 => 0.0,
+                        _ => 1e-3 * (1 + trial % 3) as f32,
+                    })
+                    .collect();
+                let mut sum = KahanSum::new();
+                for &x in &w {
+                    sum.add(x);
+                }
+                let mut a = std::vec![0u32; n];
+                let mut b = std::vec![0u32; n];
+                let mut scratch = std::vec![0.0f32; n];
+                let mut r1 = rng.clone();
+                let mut r2 = rng.clone();
+                let ok1 = resample(Scheme::Systematic, &w, &mut a, &mut r1).is_ok();
+                let ok2 = systematic(&w, sum.value(), &mut scratch, &mut b, &mut r2);
+                assert_eq!(ok1, ok2, "n {n} trial {trial}");
+                if ok1 {
+                    assert_eq!(a, b, "n {n} trial {trial}");
+                }
+                assert_eq!(r1, r2);
+                rng.next_u32();
+            }
+        }
+        // All zero: both refuse, nothing drawn.
+        let w = [0.0f32; 4];
+        let mut r = Rng::seed_from_u64(1);
+        let before = r.clone();
+        assert!(!systematic(&w, 0.0, &mut [0.0; 4], &mut [0; 4], &mut r));
+        assert_eq!(r, before);
     }
 }
