@@ -304,3 +304,71 @@ proptest! {
         }
     }
 }
+
+/// `redetect(g)` on a completed period equals a detector configured with `gamma_1 = g`
+/// fed the same scans (the calibration in `reproduce mht --gamma-from sim` relies on it),
+/// for every `g` and over periods with targets, clutter chains and confirmed tracks.
+#[test]
+fn redetect_equals_a_detector_configured_with_that_gamma() {
+    let mut rng = Rng::seed_from_u64(31);
+    let mut base = Box::new(Small::new(small_cfg()).unwrap());
+    assert_eq!(
+        base.redetect(5).unwrap_err(),
+        Error::InvalidConfig("no completed period")
+    );
+    let mut with_tracks = 0;
+    for period in 0..6 {
+        let scans: Vec<Vec<Plot>> = (0..12)
+            .map(|s| {
+                let mut plots = random_scan(&mut rng, 40 + 10 * period, 1500.0);
+                for t in 0..3 {
+                    if rng.uniform() < 0.9 {
+                        plots.push(Plot::new(
+                            9.0,
+                            200.0 + 400.0 * t as f32 + 60.0 * s as f32 + 5.0 * rng.normal(),
+                            1300.0 - 250.0 * t as f32 - 40.0 * s as f32 + 5.0 * rng.normal(),
+                        ));
+                    }
+                }
+                plots
+            })
+            .collect();
+        for (s, p) in scans.iter().enumerate() {
+            base.step(p).unwrap();
+            if s < 11 {
+                assert!(base.redetect(5).is_err(), "mid-period redetect must fail");
+            }
+        }
+        assert_eq!(
+            base.redetect(0).unwrap_err(),
+            Error::InvalidConfig("gamma1")
+        );
+        for g in (1..=13u8).rev() {
+            let mut cfg = small_cfg();
+            cfg.gamma1 = g;
+            let mut fresh = Box::new(Small::new(cfg).unwrap());
+            let mut want = None;
+            for p in &scans {
+                want = fresh.step(p).unwrap().detection;
+            }
+            let got = base.redetect(g).unwrap();
+            assert_eq!(Some(got), want, "period {period} gamma {g}");
+            assert_eq!(base.tracks().len(), fresh.tracks().len());
+            for (a, b) in base.tracks().iter().zip(fresh.tracks()) {
+                assert_eq!(a.plots, b.plots);
+                assert_eq!(a.peak, b.peak);
+                assert_eq!(a.theta.to_bits(), b.theta.to_bits());
+                assert_eq!(a.c.to_bits(), b.c.to_bits());
+                assert_eq!(
+                    (a.n_plots, a.n_effective, a.lookback),
+                    (b.n_plots, b.n_effective, b.lookback)
+                );
+            }
+            with_tracks += usize::from(!base.tracks().is_empty());
+        }
+        // the configured gamma_1 is unchanged
+        assert_eq!(base.config().gamma1, 7);
+    }
+    // the comparison covered confirmed tracks, not only empty periods
+    assert!(with_tracks >= 20, "{with_tracks}");
+}

@@ -78,6 +78,164 @@ pub struct Args {
     /// `compound-nc` is the compound law with the paper's `N_c` chains (for comparison).
     #[arg(long, value_enum, default_value_t = ModelChoice::Compound)]
     pub model: ModelChoice,
+    /// Where `gamma_1` comes from: `model` (the `--model` law's grid Pfa) or `sim`
+    /// (clutter-only simulation: the smallest `gamma_1` whose rate of periods with a
+    /// confirmed track meets `--pfa` by `--calib-rule`, see [`calibrate`]).
+    #[arg(long, value_enum, default_value_t = GammaFrom::Model)]
+    pub gamma_from: GammaFrom,
+    /// Clutter-only periods per lambda for `--gamma-from sim`.
+    #[arg(long, default_value_t = 20_000)]
+    pub calib_periods: usize,
+    /// Independent clutter-only periods per lambda that check the calibrated `gamma_1`
+    /// (0: no check).
+    #[arg(long, default_value_t = 10_000)]
+    pub calib_check: usize,
+    /// Calibration rule: `point` (estimated rate `k / T <= pfa`) or `upper` (the
+    /// Clopper-Pearson 95 % interval's upper end `<= pfa`; needs `T >~ 3.7 / pfa`).
+    #[arg(long, value_enum, default_value_t = CalibRule::Point)]
+    pub calib_rule: CalibRule,
+    /// Smallest candidate `gamma_1` of the calibration (candidates below it are not
+    /// simulated; a result at this floor is flagged).
+    #[arg(long, default_value_t = 3)]
+    pub calib_min_gamma: u8,
+}
+
+/// `--gamma-from` values.
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub enum GammaFrom {
+    /// The `--model` law.
+    #[default]
+    Model,
+    /// Clutter-only simulation of the confirmed-false-track rate ([`calibrate`]).
+    Sim,
+}
+
+/// `--calib-rule` values: how a candidate `gamma_1` passes with `k` of `T` clutter-only
+/// periods giving a confirmed track.
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub enum CalibRule {
+    /// `k / T <= pfa`.
+    #[default]
+    Point,
+    /// Clopper-Pearson 95 % upper end `<= pfa` (one-sided 97.5 %).
+    Upper,
+}
+
+impl CalibRule {
+    /// Does `k` of `n` periods with a confirmed track pass at the wanted `pfa`?
+    pub fn passes(self, k: u64, n: u64, pfa: f64) -> bool {
+        match self {
+            Self::Point => (k as f64) <= pfa * n as f64,
+            Self::Upper => proportion_ci(k, n).2 <= pfa,
+        }
+    }
+}
+
+/// Clutter-only false-track counts per candidate `gamma_1` (index = `gamma_1`).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct FalseTrackCounts {
+    /// Periods simulated.
+    pub periods: u64,
+    /// Smallest candidate simulated (entries below it are not measured).
+    pub floor: u8,
+    /// `with_track[g]`: periods with at least one confirmed track at `gamma_1 = g`.
+    pub with_track: Vec<u64>,
+    /// `tracks[g]`: confirmed tracks at `gamma_1 = g`, summed over the periods.
+    pub tracks: Vec<u64>,
+}
+
+/// Simulate `periods` clutter-only periods of `sc` (targets removed; period `i` uses
+/// `Rng::from_stream(seed, i)` through [`crate::montecarlo::run_trials`]) and count the
+/// confirmed tracks, all false, for every `gamma_1` in `floor..=N`. Each period is
+/// censored and integrated once; [`MhtTbd::redetect`] re-runs only the threshold,
+/// condensing and track confirmation per candidate, and only for candidates up to the
+/// period's largest DMHT count (no cell reaches a higher `gamma_1`: no peak, no track).
+pub fn false_track_counts(
+    sc: &SeaClutter,
+    periods: usize,
+    seed: u64,
+    floor: u8,
+) -> FalseTrackCounts {
+    let mut null_sc = *sc;
+    null_sc.n_targets = 0;
+    let n = null_sc.n_scans;
+    let floor = floor.max(1);
+    // gamma_1 = N + 1 at the step itself: no cell reaches it, the step's own stage 3 is
+    // a no-op and every candidate comes from `redetect`.
+    let g_step = (n + 1).min(255) as u8;
+    let per: Vec<Vec<u16>> = crate::montecarlo::run_trials(
+        seed,
+        periods,
+        &format!("calib lambda={}", sc.lambda),
+        |_, rng| {
+            let mut out = vec![0u16; n + 1];
+            let Ok((mut m, _)) = detectors(&null_sc, g_step, 1) else {
+                return out;
+            };
+            let tr = null_sc.generate(rng);
+            for scan in &tr.scans {
+                let _ = m.step(&scan.plots);
+            }
+            let top = usize::from(max_count(m.accumulator())).min(n);
+            for (g, o) in out
+                .iter_mut()
+                .enumerate()
+                .take(top + 1)
+                .skip(usize::from(floor))
+            {
+                if let Ok(d) = m.redetect(g as u8) {
+                    *o = d.tracks;
+                }
+            }
+            out
+        },
+    );
+    let mut c = FalseTrackCounts {
+        periods: periods as u64,
+        floor,
+        with_track: vec![0; n + 1],
+        tracks: vec![0; n + 1],
+    };
+    for p in &per {
+        for (g, &t) in p.iter().enumerate() {
+            c.with_track[g] += u64::from(t > 0);
+            c.tracks[g] += u64::from(t);
+        }
+    }
+    c
+}
+
+/// Periods of the pilot batch of [`pilot_floor`].
+pub const PILOT_PERIODS: usize = 200;
+
+/// The calibration's floor from a pilot batch of [`PILOT_PERIODS`] clutter-only periods
+/// (seeds `Rng::from_stream(seed, i)`; not reused by the calibration): the largest
+/// `gamma_1 >= min_gamma` at which at least 10 % of the pilot periods give a confirmed
+/// track (`min_gamma` when none). A rate of >= 10 % in 200 periods puts the true rate far
+/// above any `Pfa` worth calibrating (< 1e-2), so the calibration fails there and never
+/// needs the candidates below, which are the costly ones (many peaks to recover).
+pub fn pilot_floor(sc: &SeaClutter, seed: u64, min_gamma: u8) -> u8 {
+    let c = false_track_counts(sc, PILOT_PERIODS, seed, min_gamma);
+    let min = usize::from(c.floor);
+    (min..c.with_track.len())
+        .rev()
+        .find(|&g| 10 * c.with_track[g] >= c.periods)
+        .map_or(c.floor, |g| g.min(255) as u8)
+}
+
+/// The calibrated `gamma_1`: the smallest candidate `g >= floor` such that every
+/// candidate `g' >= g` passes `rule` (the rate need not be monotone in `gamma_1`: the
+/// confirmation needs `confirm_frac * gamma_1` plots); `N + 1` (never fires) if even
+/// `N` fails. The second value is true when the result is the floor itself (the rate
+/// below it was not measured: lower `--calib-min-gamma`).
+pub fn calibrate(c: &FalseTrackCounts, pfa: f64, rule: CalibRule) -> (usize, bool) {
+    let n = c.with_track.len().saturating_sub(1);
+    let floor = usize::from(c.floor).max(1);
+    let mut g = n + 1;
+    while g > floor && rule.passes(c.with_track[g - 1], c.periods, pfa) {
+        g -= 1;
+    }
+    (g, g == floor)
 }
 
 /// `--model` values.
@@ -614,7 +772,56 @@ struct Summary {
     null_pfa_model: f64,
     null_confirmed_fa_trials: u64,
     classic_null_pfa_sim: f64,
+    gamma1_model: usize,
+    calib_periods: u64,
+    calib_periods_with_track: u64,
+    calib_rate: f64,
+    calib_rate_hi: f64,
+    calib_at_floor: bool,
+    check_periods: u64,
+    check_periods_with_track: u64,
+    check_tracks: u64,
+    check_rate: f64,
+    check_rate_lo: f64,
+    check_rate_hi: f64,
 }
+
+/// Calibration / check row (`calib.csv`).
+#[derive(Debug, serde::Serialize)]
+struct CalibRow {
+    lambda: f32,
+    batch: &'static str,
+    gamma: usize,
+    periods: u64,
+    periods_with_track: u64,
+    tracks: u64,
+    rate: f64,
+    rate_lo: f64,
+    rate_hi: f64,
+}
+
+fn calib_rows(lambda: f32, batch: &'static str, c: &FalseTrackCounts, rows: &mut Vec<CalibRow>) {
+    for g in usize::from(c.floor)..c.with_track.len() {
+        let (p, lo, hi) = proportion_ci(c.with_track[g], c.periods);
+        rows.push(CalibRow {
+            lambda,
+            batch,
+            gamma: g,
+            periods: c.periods,
+            periods_with_track: c.with_track[g],
+            tracks: c.tracks[g],
+            rate: p,
+            rate_lo: lo,
+            rate_hi: hi,
+        });
+    }
+}
+
+/// Seed tags of the pilot, calibration and check batches (independent of the scoring trials'
+/// `derive_seed(seed, li)` and of the null trials' `seed ^ 0x6e75_6c6c`).
+const CALIB_TAG: u64 = 0x6361_6c69_6200_0001;
+const CHECK_TAG: u64 = 0x6368_6563_6b00_0002;
+const PILOT_TAG: u64 = 0x7069_6c6f_7400_0003;
 
 /// Entry point.
 pub fn run(args: &Args) -> anyhow::Result<()> {
@@ -634,19 +841,71 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if let Some(g) = args.gamma1 {
         anyhow::ensure!(g >= 1, "--gamma1 must be at least 1");
     }
-    let (trials, null_trials) = if args.quick {
-        (20, 20)
+    anyhow::ensure!(
+        !(args.gamma1.is_some() && args.gamma_from == GammaFrom::Sim),
+        "--gamma1 and --gamma-from sim exclude each other"
+    );
+    let (trials, null_trials, calib_periods, calib_check) = if args.quick {
+        (20, 20, 200, 200)
     } else {
-        (args.trials, args.null_trials)
+        (
+            args.trials,
+            args.null_trials,
+            args.calib_periods,
+            args.calib_check,
+        )
     };
+    if args.gamma_from == GammaFrom::Sim {
+        anyhow::ensure!(calib_periods > 0, "--calib-periods must be at least 1");
+        if args.calib_rule == CalibRule::Upper && (calib_periods as f64) * args.pfa < 3.7 {
+            eprintln!(
+                "warning: --calib-rule upper with {calib_periods} periods cannot reach pfa {} (zero events give an upper bound ~3.7 / T): gamma_1 will be N + 1",
+                args.pfa
+            );
+        }
+    }
+    let mut calib_csv = Vec::new();
     std::fs::create_dir_all(&args.out)?;
     let model_md = model_figures(&args.out)?;
     let mut summaries = Vec::new();
     let mut null_rows = Vec::new();
     for (li, &lambda) in args.lambda.iter().enumerate() {
         let sc = SeaClutter::paper(lambda);
-        let (g1, gc) = thresholds_with(&sc, args.pfa, args.model);
-        let g1 = args.gamma1.map_or(g1, usize::from);
+        let (g1_model, gc) = thresholds_with(&sc, args.pfa, args.model);
+        let mut calib = None;
+        let mut check = None;
+        let g1 = if let Some(g) = args.gamma1 {
+            usize::from(g)
+        } else if args.gamma_from == GammaFrom::Sim {
+            let floor = pilot_floor(
+                &sc,
+                faint_core::rng::derive_seed(args.seed ^ PILOT_TAG, li as u64),
+                args.calib_min_gamma,
+            );
+            let c = false_track_counts(
+                &sc,
+                calib_periods,
+                faint_core::rng::derive_seed(args.seed ^ CALIB_TAG, li as u64),
+                floor,
+            );
+            let (g, at_floor) = calibrate(&c, args.pfa, args.calib_rule);
+            calib_rows(lambda, "calib", &c, &mut calib_csv);
+            if calib_check > 0 {
+                // the check needs the chosen gamma_1 only; two below it for context
+                let k = false_track_counts(
+                    &sc,
+                    calib_check,
+                    faint_core::rng::derive_seed(args.seed ^ CHECK_TAG, li as u64),
+                    (g.saturating_sub(2).clamp(1, 255) as u8).max(args.calib_min_gamma),
+                );
+                calib_rows(lambda, "check", &k, &mut calib_csv);
+                check = Some(k);
+            }
+            calib = Some((c, at_floor));
+            g
+        } else {
+            g1_model
+        };
         let g1u = g1.clamp(1, 255) as u8;
         let gcu = gc.clamp(1, 255) as u8;
         // Surface a configuration error once, before the trials (which cannot report it).
@@ -760,10 +1019,44 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             null_pfa_model: null_model.pfa_grid(g1),
             null_confirmed_fa_trials: nres.iter().filter(|t| t.mht_false > 0).count() as u64,
             classic_null_pfa_sim: chit / null_trials.max(1) as f64,
+            gamma1_model: g1_model,
+            calib_periods: calib.as_ref().map_or(0, |c| c.0.periods),
+            calib_periods_with_track: calib
+                .as_ref()
+                .and_then(|c| c.0.with_track.get(g1).copied())
+                .unwrap_or(0),
+            calib_rate: calib.as_ref().map_or(f64::NAN, |c| {
+                proportion_ci(c.0.with_track.get(g1).copied().unwrap_or(0), c.0.periods).0
+            }),
+            calib_rate_hi: calib.as_ref().map_or(f64::NAN, |c| {
+                proportion_ci(c.0.with_track.get(g1).copied().unwrap_or(0), c.0.periods).2
+            }),
+            calib_at_floor: calib.as_ref().is_some_and(|c| c.1),
+            check_periods: check.as_ref().map_or(0, |c| c.periods),
+            check_periods_with_track: check
+                .as_ref()
+                .and_then(|c| c.with_track.get(g1).copied())
+                .unwrap_or(0),
+            check_tracks: check
+                .as_ref()
+                .and_then(|c| c.tracks.get(g1).copied())
+                .unwrap_or(0),
+            check_rate: check.as_ref().map_or(f64::NAN, |c| {
+                proportion_ci(c.with_track.get(g1).copied().unwrap_or(0), c.periods).0
+            }),
+            check_rate_lo: check.as_ref().map_or(f64::NAN, |c| {
+                proportion_ci(c.with_track.get(g1).copied().unwrap_or(0), c.periods).1
+            }),
+            check_rate_hi: check.as_ref().map_or(f64::NAN, |c| {
+                proportion_ci(c.with_track.get(g1).copied().unwrap_or(0), c.periods).2
+            }),
         });
     }
     write_csv(&args.out.join("summary.csv"), &summaries)?;
     write_csv(&args.out.join("null_pfa.csv"), &null_rows)?;
+    if !calib_csv.is_empty() {
+        write_csv(&args.out.join("calib.csv"), &calib_csv)?;
+    }
     // figures 10-12
     let xs = |f: &dyn Fn(&Summary) -> f64| {
         summaries
@@ -834,7 +1127,23 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     )?;
     // markdown
     let mut md = String::new();
-    md += &format!("Trials per lambda: {trials} with 5 targets, {null_trials} clutter-only; thresholds for grid Pfa <= {} from the {:?} model.\n\n", args.pfa, args.model);
+    if args.gamma_from == GammaFrom::Sim {
+        md += &format!("Trials per lambda: {trials} with 5 targets, {null_trials} clutter-only; gamma_1 calibrated by simulation: smallest gamma_1 whose clutter-only periods with a confirmed track are <= {} by rule {:?} ({calib_periods} calibration periods, every larger gamma_1 passing too), checked on {calib_check} independent periods.\n\n", args.pfa, args.calib_rule);
+        md += "| lambda | gamma_1 (sim) | gamma_1 (model) | calibration: periods with a confirmed track | rate [95% CI] | at floor | check: periods with a confirmed track (tracks) | check rate [95% CI] |\n|---|---|---|---|---|---|---|---|\n";
+        for s in &summaries {
+            let (_, clo, _) = proportion_ci(s.calib_periods_with_track, s.calib_periods);
+            md += &format!(
+                "| {} | {} | {} | {} / {} | {:.2e} [{:.2e}, {:.2e}] | {} | {} / {} ({}) | {:.2e} [{:.2e}, {:.2e}] |\n",
+                s.lambda, s.gamma1, s.gamma1_model, s.calib_periods_with_track, s.calib_periods,
+                s.calib_rate, clo, s.calib_rate_hi, s.calib_at_floor,
+                s.check_periods_with_track, s.check_periods, s.check_tracks,
+                s.check_rate, s.check_rate_lo, s.check_rate_hi
+            );
+        }
+        md += "\n";
+    } else {
+        md += &format!("Trials per lambda: {trials} with 5 targets, {null_trials} clutter-only; thresholds for grid Pfa <= {} from the {:?} model.\n\n", args.pfa, args.model);
+    }
     md += "| lambda | gamma_1 | clutter/scan before | after (sim) | after (paper N_c m0 / N) | after (compound chains) | target plots kept | MHT Pd [95% CI] | MHT false tracks (trials with FA) | plot loss | wrong plot | classic gamma | classic Pd | classic false peaks (trials with FA) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for s in &summaries {
         md += &format!(

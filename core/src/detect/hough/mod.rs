@@ -216,6 +216,9 @@ pub struct MhtTbd<const P: usize, const NS: usize, const R: usize, const A: usiz
     tracks: [Track<NS>; T],
     ntracks: usize,
     scan: usize,
+    /// Stage-3 input summary of the period the last `step` completed (for
+    /// [`MhtTbd::redetect`]); `None` otherwise.
+    period: Option<Detection>,
 }
 
 impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: usize>
@@ -253,6 +256,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
             tracks: [Track::empty(); T],
             ntracks: 0,
             scan: usize::MAX,
+            period: None,
         }
     }
 
@@ -269,6 +273,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
         self.counts = [0; NS];
         self.ntracks = 0;
         self.scan = 0;
+        self.period = None;
         Ok(())
     }
 
@@ -336,6 +341,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
         if s >= NS {
             return Err(Error::InvalidConfig("unconfigured"));
         }
+        self.period = None;
         if s == 0 {
             self.counts = [0; NS];
             self.ntracks = 0;
@@ -383,8 +389,36 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
         Ok(rep)
     }
 
+    /// Re-run the `gamma_1`-dependent part of stage 3 (threshold, condensing, track
+    /// recovery, confirmation, residual rule) on the period the last [`MhtTbd::step`]
+    /// completed, with `gamma1` in place of the configured `gamma_1`. Censoring and the
+    /// binary integration do not depend on `gamma_1`, so the result (and
+    /// [`MhtTbd::tracks`], which it replaces) is exactly what `step` would have given with
+    /// `gamma_1 = gamma1`. The configured `gamma_1` is unchanged. Used to calibrate
+    /// `gamma_1` by simulation without censoring a period once per candidate.
+    ///
+    /// Errors: `InvalidConfig("gamma1")` for 0, `InvalidConfig("no completed period")`
+    /// when the last `step` did not complete a period.
+    pub fn redetect(&mut self, gamma1: u8) -> Result<Detection> {
+        if gamma1 == 0 {
+            return Err(Error::InvalidConfig("gamma1"));
+        }
+        let det = self
+            .period
+            .ok_or(Error::InvalidConfig("no completed period"))?;
+        Ok(self.extract(gamma1, det))
+    }
+
     /// Stage 3 over the completed period.
     fn detect(&mut self) -> Detection {
+        let det = self.integrate();
+        self.period = Some(det);
+        self.extract(self.cfg.gamma1, det)
+    }
+
+    /// Stage 3, the part independent of `gamma_1`: DMHT geometry, binary integration and
+    /// smoothing of `S_ep`.
+    fn integrate(&mut self) -> Detection {
         let ns = self.cfg.n_scans;
         let mut det = Detection::default();
         // centroid and extent of S_ep (f64-free: two-pass in f32 about the area centre)
@@ -439,7 +473,14 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
             }
         }
         self.acc.finish(self.cfg.smooth);
-        det.condense = self.acc.condense(self.cfg.gamma1, &mut self.peaks);
+        det
+    }
+
+    /// Stage 3, the part that depends on `gamma_1`: threshold, condensing, track recovery
+    /// and confirmation (an empty accumulator gives no peaks).
+    fn extract(&mut self, gamma1: u8, mut det: Detection) -> Detection {
+        let ns = self.cfg.n_scans;
+        det.condense = self.acc.condense(gamma1, &mut self.peaks);
         // track recovery
         let assoc = dmht::Assoc {
             d_max: self.cfg.d_max,
@@ -460,7 +501,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
                 &assoc,
                 &mut tr,
             );
-            let need = self.cfg.confirm_frac * f32::from(self.cfg.gamma1);
+            let need = self.cfg.confirm_frac * f32::from(gamma1);
             if tr.n_plots < self.cfg.min_track_plots || f32::from(tr.n_effective) < need {
                 det.short += 1;
                 continue;
@@ -495,7 +536,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
                     });
                     resid = resid.saturating_add(u8::from(hit));
                 }
-                if resid < self.cfg.gamma1 {
+                if resid < gamma1 {
                     det.residual += 1;
                     continue;
                 }
