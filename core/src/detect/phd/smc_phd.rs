@@ -59,6 +59,12 @@ pub enum BirthMode {
         cells: usize,
         /// Standard deviation of the unobserved tangential velocity (m/s).
         tangential_std: f32,
+        /// Two-frame velocity (0 = off): a birth particle's tangential velocity is
+        /// instead its displacement from a point drawn in one of the component's cells
+        /// of the frame before (k-2) over `T`, if that gives a speed of at most this
+        /// (m/s) with the particle's Doppler; up to 4 cells tried, else
+        /// `N(0, tangential_std^2)`.
+        pair_max_speed: f32,
     },
 }
 
@@ -162,9 +168,14 @@ impl Config {
         if let BirthMode::Measurement {
             cells,
             tangential_std,
+            pair_max_speed,
         } = b.mode
         {
-            if cells == 0 || cells > MAX_BIRTH_CELLS || !nonneg(tangential_std) {
+            if cells == 0
+                || cells > MAX_BIRTH_CELLS
+                || !nonneg(tangential_std)
+                || !nonneg(pair_max_speed)
+            {
                 return Err(Error::InvalidConfig("birth measurement mode"));
             }
         }
@@ -262,6 +273,9 @@ pub struct SmcPhdTbd<const N: usize, const S: usize, const M: usize, const K: us
     /// Measurement-driven birth cells chosen on the previous frame, per component.
     birth_cells: [[(usize, f32); MAX_BIRTH_CELLS]; MAX_BIRTH_COMPONENTS],
     birth_nb: [usize; MAX_BIRTH_COMPONENTS],
+    /// The same, chosen the frame before (for two-frame birth velocities).
+    birth_prev: [[(usize, f32); MAX_BIRTH_CELLS]; MAX_BIRTH_COMPONENTS],
+    birth_prev_nb: [usize; MAX_BIRTH_COMPONENTS],
 }
 
 /// The 13 "forward" neighbours of a cell (the other 13 are found from the other side).
@@ -328,6 +342,8 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             rng: Rng::seed_from_u64(seed),
             birth_cells: [[(0, 0.0); MAX_BIRTH_CELLS]; MAX_BIRTH_COMPONENTS],
             birth_nb: [0; MAX_BIRTH_COMPONENTS],
+            birth_prev: [[(0, 0.0); MAX_BIRTH_CELLS]; MAX_BIRTH_COMPONENTS],
+            birth_prev_nb: [0; MAX_BIRTH_COMPONENTS],
         })
     }
 
@@ -359,6 +375,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         self.n_est = 0;
         self.rng = Rng::seed_from_u64(seed);
         self.birth_nb = [0; MAX_BIRTH_COMPONENTS];
+        self.birth_prev_nb = [0; MAX_BIRTH_COMPONENTS];
     }
 
     /// The configuration.
@@ -475,9 +492,19 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             // *previous* frame, propagated one step (`choose_birth_cells`).
             let cells = self.birth_cells[ci];
             let nb = self.birth_nb[ci];
-            let tang = match b.mode {
-                BirthMode::Measurement { tangential_std, .. } => tangential_std,
-                BirthMode::Gaussian => 0.0,
+            let (tang, vmax) = match b.mode {
+                BirthMode::Measurement {
+                    tangential_std,
+                    pair_max_speed,
+                    ..
+                } => (tangential_std, pair_max_speed),
+                BirthMode::Gaussian => (0.0, 0.0),
+            };
+            let prev = self.birth_prev[ci];
+            let np = if vmax > 0.0 {
+                self.birth_prev_nb[ci]
+            } else {
+                0
             };
             for _ in 0..count {
                 let s = if nb > 0 {
@@ -489,7 +516,23 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                         + (lb as f32 + self.rng.uniform()) * g.azimuth_cell_deg)
                         / DEG_PER_RAD;
                     let (sb, cb) = (math::sin(az), math::cos(az));
-                    let vt = tang * self.rng.normal();
+                    let mut vt = tang * self.rng.normal();
+                    for _ in 0..np.min(4) {
+                        let (pidx, _) = prev[self.rng.below(np as u32) as usize];
+                        let (pr, _, pl) = g.unindex(pidx);
+                        let r2 = g.range_start + (pr as f32 + self.rng.uniform()) * g.range_cell;
+                        let a2 = (g.azimuth_start_deg
+                            + (pl as f32 + self.rng.uniform()) * g.azimuth_cell_deg)
+                            / DEG_PER_RAD;
+                        let (dx, dy) = (r * cb - r2 * math::cos(a2), r * sb - r2 * math::sin(a2));
+                        // Tangential part of the displacement (the radial velocity comes
+                        // from the Doppler cell).
+                        let v2 = (-dx * sb + dy * cb) / self.cfg.dt;
+                        if d * d + v2 * v2 <= vmax * vmax {
+                            vt = v2;
+                            break;
+                        }
+                    }
                     let (vx, vy) = (d * cb - vt * sb, d * sb + vt * cb);
                     let t = self.cfg.dt;
                     [r * cb + t * vx, vx, r * sb + t * vy, vy]
@@ -520,6 +563,8 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
     fn choose_birth_cells(&mut self, cube: &PowerCube<'_>) {
         let b = self.cfg.birth;
         let g = self.cfg.geometry;
+        self.birth_prev = self.birth_cells;
+        self.birth_prev_nb = self.birth_nb;
         for ci in 0..b.n_components.min(MAX_BIRTH_COMPONENTS) {
             self.birth_nb[ci] = match b.mode {
                 BirthMode::Measurement { cells: want, .. } => Self::strongest_in_window(
