@@ -165,10 +165,19 @@ pub fn crowding_distance<const M: usize>(
 /// PSO settings (eq. 8-9, 18-19 and the stop rule).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PsoConfig {
-    /// Maximum generations per frame, `gen` (paper: 10).
+    /// Generations run every frame, `gen` (paper: 10). §3.1: "after the iteration count
+    /// is reached, the fitness threshold is the final condition for ending the
+    /// optimisation", so the threshold is checked only once `gen` generations ran.
     pub generations: usize,
-    /// Stop when the swarm's mean best-objective fitness reaches this, `Th_pso` (0.7).
+    /// After `generations`, continue while the swarm's mean best-objective fitness is
+    /// below this, `Th_pso` (0.7).
     pub threshold: f32,
+    /// Hard cap on generations per frame (ours: bounded work per frame; the paper has
+    /// none). Values below `generations` are treated as `generations`.
+    pub max_generations: usize,
+    /// `Z_m` at the local maximum of the frame's log likelihood ratio inside the chosen
+    /// cell (sub-cell), instead of the cell centre.
+    pub refine_points: bool,
     /// Inertia `w` of eq. 8.
     pub inertia: f32,
     /// Cognitive factor `c1`.
@@ -194,6 +203,8 @@ impl PsoConfig {
         Self {
             generations: 10,
             threshold: 0.7,
+            max_generations: 20,
+            refine_points: true,
             inertia: 0.5,
             c1: 1.0,
             c2: 1.0,
@@ -221,6 +232,8 @@ pub struct Swarm<const S: usize, const M: usize> {
     pub weight: [f32; S],
     /// Filter particle each entry descends from.
     pub src: [u32; S],
+    /// Selection group of each entry (the caller's target group; children inherit it).
+    group: [u16; S],
     rank: [u32; S],
     crowd: [f32; S],
     order: [u32; S],
@@ -256,6 +269,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             fit: [[0.0; M]; S],
             weight: [0.0; S],
             src: [0; S],
+            group: [0; S],
             rank: [0; S],
             crowd: [0.0; S],
             order: [0; S],
@@ -275,8 +289,11 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
         self.len = 0;
     }
 
-    /// Adds a parent; returns false when full.
-    pub fn push(&mut self, pos: [f32; 2], weight: f32, src: u32) -> bool {
+    /// Adds a parent in selection group `group`; returns false when full.
+    ///
+    /// The elitist selection keeps, per group, as many entries as the group had parents:
+    /// the swarm moves particles, it must not move them between the PHD's targets.
+    pub fn push(&mut self, pos: [f32; 2], weight: f32, src: u32, group: u16) -> bool {
         if self.len >= S / 2 {
             return false;
         }
@@ -287,6 +304,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
         self.pbest_fit[i] = -1.0;
         self.weight[i] = weight;
         self.src[i] = src;
+        self.group[i] = group;
         self.len += 1;
         true
     }
@@ -331,8 +349,8 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     /// per generation, children by eq. 8-9 plus mutation (entry `i % 3`: 0 unchanged,
     /// 1 one common uniform increment, 2 an own uniform increment), fitness eq. 18-19,
     /// merge, non-dominated sort, weighted crowding, keep the best `len` by
-    /// (front, crowding). Stops after `generations` or when the mean best-objective
-    /// fitness reaches `threshold`. Weights ride along; the caller renormalises.
+    /// (front, crowding). Runs `generations`, then continues while the mean
+    /// best-objective fitness is below `threshold`, at most `max_generations` in all. Weights ride along; the caller renormalises.
     pub fn run(&mut self, cfg: &PsoConfig, points: &[[f32; 2]], rng: &mut Rng) -> SwarmReport {
         let n = self.len;
         let m = points.len().min(M);
@@ -348,7 +366,8 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
         mean_best /= n as f32;
         let obj_w = [1.0f32 / m as f32; M];
         let mut gens = 0usize;
-        while gens < cfg.generations && mean_best < cfg.threshold {
+        let cap = cfg.max_generations.max(cfg.generations);
+        while gens < cap && (gens < cfg.generations || mean_best < cfg.threshold) {
             gens += 1;
             // Leaders: per objective, the front-0 entry with the highest value.
             let fronts = non_dominated_sort(
@@ -406,6 +425,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
                 self.pbest_fit[c] = self.pbest_fit[i];
                 self.weight[c] = self.weight[i];
                 self.src[c] = self.src[i];
+                self.group[c] = self.group[i];
                 self.evaluate(c, points, inv_two_s2, cfg.gate);
             }
             // Elitist selection over parents + children.
@@ -428,11 +448,12 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
                 &mut self.order[..tot],
             );
             {
-                let (rank, crowd) = (&self.rank, &self.crowd);
+                let (rank, crowd, group) = (&self.rank, &self.crowd, &self.group);
                 self.order[..tot].sort_unstable_by(|&a, &b| {
                     let (a, b) = (a as usize, b as usize);
-                    rank[a]
-                        .cmp(&rank[b])
+                    group[a]
+                        .cmp(&group[b])
+                        .then(rank[a].cmp(&rank[b]))
                         .then(
                             crowd[b]
                                 .partial_cmp(&crowd[a])
@@ -441,8 +462,29 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
                         .then(a.cmp(&b))
                 });
             }
-            // Keep the first n, compacted in ascending index order (safe forward copy).
-            self.order[..n].sort_unstable();
+            // Per group, keep the best `parents of the group` entries (a global cut
+            // would keep the groups whose fronts are wide, i.e. targets near several
+            // points, and drop the others' particles: measured, a target with one
+            // point lost 99.9 % of its swarm entries in one frame). Every parent and
+            // child of group g sits in the contiguous run of g in `order`, and the run
+            // holds twice the group's parents, so `kept` ends at n.
+            let mut kept = 0usize;
+            let mut s0 = 0usize;
+            while s0 < tot {
+                let gi = self.group[self.order[s0] as usize];
+                let mut e0 = s0;
+                while e0 < tot && self.group[self.order[e0] as usize] == gi {
+                    e0 += 1;
+                }
+                let keep = (e0 - s0) / 2;
+                for t in s0..s0 + keep {
+                    self.order[kept] = self.order[t];
+                    kept += 1;
+                }
+                s0 = e0;
+            }
+            // Compacted in ascending index order (safe forward copy).
+            self.order[..kept].sort_unstable();
             mean_best = 0.0;
             for k in 0..n {
                 let s = self.order[k] as usize;
@@ -453,6 +495,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
                 self.fit[k] = self.fit[s];
                 self.weight[k] = self.weight[s];
                 self.src[k] = self.src[s];
+                self.group[k] = self.group[s];
                 mean_best += self.best_objective(k, m).1;
             }
             mean_best /= n as f32;
