@@ -466,16 +466,17 @@ fn risk_pass(
     let draw = ExistenceDraw::new(&model.chain);
     let mut rng = rng_out.clone();
     let mut dmin = f32::INFINITY;
-    let mut n_absent = 0u32;
-    for (i, (&e, o)) in exists.iter().zip(out.iter_mut()).enumerate() {
+    // Present particles are counted (not absent ones), and the three arrays are zipped
+    // (no index, no bounds check), so the loop over mostly absent particles keeps
+    // everything in registers.
+    let mut n_present = 0usize;
+    let n = exists.len().min(out.len()).min(parts.len());
+    for ((&e, o), p) in exists.iter().zip(out.iter_mut()).zip(parts.iter()) {
         if draw.next(e, &mut rng) {
-            let x = match parts.get(i) {
-                Some(p) => &p.x,
-                None => break,
-            };
-            let (r, d2) = risk_present(model, z, zz, x, e, rng);
+            let (r, d2) = risk_present(model, z, zz, &p.x, e, rng);
             rng = r;
             *o = d2;
+            n_present += 1;
             // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never
             // NaN.
             if d2 < dmin {
@@ -483,10 +484,9 @@ fn risk_pass(
             }
         } else {
             *o = zz_floor;
-            n_absent += 1;
         }
     }
-    if n_absent > 0 && zz_floor < dmin {
+    if n_present < n && zz_floor < dmin {
         dmin = zz_floor;
     }
     *rng_out = rng;
