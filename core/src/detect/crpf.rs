@@ -713,12 +713,15 @@ impl<const N: usize> CrpfTbd<N> {
         // With lambda = 0 an absent particle's state is never read again: only its flag
         // is written.
         let keep_absent = self.cfg.lambda > 0.0;
-        for (i, flag) in self.exists.iter_mut().enumerate() {
+        // Flags and states zipped: no index bounds check in the loop.
+        for (i, (flag, slot)) in self
+            .exists
+            .iter_mut()
+            .zip(self.parts.iter_mut())
+            .enumerate()
+        {
             let e = *flag;
             if draw.next(e, &mut rng) {
-                let Some(slot) = self.parts.get_mut(i) else {
-                    break;
-                };
                 let (r, log_c) = ctx.update_present(slot, e, rng);
                 rng = r;
                 if let Some(log_c) = log_c {
@@ -736,15 +739,13 @@ impl<const N: usize> CrpfTbd<N> {
             }
             *flag = false;
             if keep_absent {
-                if let Some(slot) = self.parts.get_mut(i) {
-                    // E = 0: x = 0, h = 0, C = lambda Cbar + ||z||^p.
-                    *slot = Particle {
-                        x: [0.0; 3],
-                        log_c: log_cost(&self.cfg, zz_floor, slot.log_c, ln_lambda),
-                        zh: Complex32::new(0.0, 0.0),
-                        hh: 0.0,
-                    };
-                }
+                // E = 0: x = 0, h = 0, C = lambda Cbar + ||z||^p.
+                *slot = Particle {
+                    x: [0.0; 3],
+                    log_c: log_cost(&self.cfg, zz_floor, slot.log_c, ln_lambda),
+                    zh: Complex32::new(0.0, 0.0),
+                    hh: 0.0,
+                };
             }
         }
         self.rng = rng;
