@@ -463,7 +463,11 @@ fn risk_pass(
     rng_out: &mut Rng,
 ) -> f32 {
     let zz_floor = zz.max(f32::MIN_POSITIVE);
-    let draw = ExistenceDraw::new(&model.chain);
+    let draw_table = ExistenceDraw::new(&model.chain);
+    // Through an opaque reference the two thresholds are read from memory by one
+    // indexed load per particle, instead of being held in two (spilled) registers and
+    // selected.
+    let draw = core::hint::black_box(&draw_table);
     let mut rng = rng_out.clone();
     let mut dmin = f32::INFINITY;
     // Present particles are counted (not absent ones), and the three arrays are zipped
@@ -709,7 +713,9 @@ impl<const N: usize> CrpfTbd<N> {
         let mut best = f32::INFINITY;
         let mut arg = None;
         let mut rng = self.rng.clone();
-        let draw = ExistenceDraw::new(&self.model.chain);
+        let draw_table = ExistenceDraw::new(&self.model.chain);
+        // Opaque reference: one indexed load per particle (see `risk_pass`).
+        let draw = core::hint::black_box(&draw_table);
         // With lambda = 0 an absent particle's state is never read again: only its flag
         // is written.
         let keep_absent = self.cfg.lambda > 0.0;
