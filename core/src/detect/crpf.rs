@@ -184,7 +184,10 @@ fn systematic(w: &[f32], sum: f32, scratch: &mut [f32], anc: &mut [u32], rng: &m
     let mut qs = scratch.iter().map(|q| q.to_bits() as u64);
     let mut i = 0u32;
     let mut gap = (m * qs.next().unwrap_or(0)) as i64 - a as i64;
-    let step = total as i64;
+    let step_value = total as i64;
+    // Read from memory by one `ldrd` per slot (opaque reference) instead of being
+    // spilled and reloaded word by word.
+    let step = core::hint::black_box(&step_value);
     for slot in anc.iter_mut() {
         while gap <= 0 {
             match qs.next() {
@@ -196,7 +199,7 @@ fn systematic(w: &[f32], sum: f32, scratch: &mut [f32], anc: &mut [u32], rng: &m
             }
         }
         *slot = i;
-        gap -= step;
+        gap -= *step;
     }
     true
 }
