@@ -208,10 +208,13 @@ fn systematic(w: &[f32], sum: f32, scratch: &mut [f32], anc: &mut [u32], rng: &m
 /// ancestors (what [`resample`] produces), like
 /// [`gather_in_place`](crate::particles::gather_in_place) but copying field by field (a
 /// whole-struct copy inside one slice compiles to a `memmove` call per particle on the
-/// M4) and, unless `all`, copying the state only of `E = 1` particles (with `lambda = 0`
+/// M4) and, unless `ALL` (`lambda > 0`), copying the state only of `E = 1` particles (with `lambda = 0`
 /// an absent particle's state is never read). Same two passes (ascending for `a > j`,
 /// descending for `a < j`).
-fn gather_particles(parts: &mut [Particle], exists: &mut [bool], anc: &[u32], all: bool) {
+///
+/// `ALL` is a constant so that each variant's loops carry no flag (it spilled).
+fn gather_particles<const ALL: bool>(parts: &mut [Particle], exists: &mut [bool], anc: &[u32]) {
+    let all = ALL;
     #[inline(always)]
     fn copy(parts: &mut [Particle], exists: &mut [bool], j: usize, a: usize, all: bool) {
         let e = match exists.get(a) {
@@ -640,7 +643,11 @@ impl<const N: usize> CrpfTbd<N> {
                 &mut self.rng,
             ) {
                 let all = self.cfg.lambda > 0.0;
-                gather_particles(&mut self.parts, &mut self.exists, &self.anc, all);
+                if all {
+                    gather_particles::<true>(&mut self.parts, &mut self.exists, &self.anc);
+                } else {
+                    gather_particles::<false>(&mut self.parts, &mut self.exists, &self.anc);
+                }
             }
             return;
         }
@@ -684,7 +691,11 @@ impl<const N: usize> CrpfTbd<N> {
         // the particles are kept as they are (identity resampling).
         if ok && resample(Scheme::Systematic, &self.w, &mut self.anc, &mut self.rng).is_ok() {
             let all = self.cfg.lambda > 0.0;
-            gather_particles(&mut self.parts, &mut self.exists, &self.anc, all);
+            if all {
+                gather_particles::<true>(&mut self.parts, &mut self.exists, &self.anc);
+            } else {
+                gather_particles::<false>(&mut self.parts, &mut self.exists, &self.anc);
+            }
         }
     }
 
