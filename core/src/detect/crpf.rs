@@ -184,7 +184,10 @@ fn systematic(w: &[f32], sum: f32, scratch: &mut [f32], anc: &mut [u32], rng: &m
     let mut qs = scratch.iter().map(|q| q.to_bits() as u64);
     let mut i = 0u32;
     let mut gap = (m * qs.next().unwrap_or(0)) as i64 - a as i64;
-    let step = total as i64;
+    let step_value = total as i64;
+    // Read from memory by one `ldrd` per slot (opaque reference) instead of being
+    // spilled and reloaded word by word.
+    let step = core::hint::black_box(&step_value);
     for slot in anc.iter_mut() {
         while gap <= 0 {
             match qs.next() {
@@ -196,7 +199,7 @@ fn systematic(w: &[f32], sum: f32, scratch: &mut [f32], anc: &mut [u32], rng: &m
             }
         }
         *slot = i;
-        gap -= step;
+        gap -= *step;
     }
     true
 }
@@ -205,10 +208,13 @@ fn systematic(w: &[f32], sum: f32, scratch: &mut [f32], anc: &mut [u32], rng: &m
 /// ancestors (what [`resample`] produces), like
 /// [`gather_in_place`](crate::particles::gather_in_place) but copying field by field (a
 /// whole-struct copy inside one slice compiles to a `memmove` call per particle on the
-/// M4) and, unless `all`, copying the state only of `E = 1` particles (with `lambda = 0`
+/// M4) and, unless `ALL` (`lambda > 0`), copying the state only of `E = 1` particles (with `lambda = 0`
 /// an absent particle's state is never read). Same two passes (ascending for `a > j`,
 /// descending for `a < j`).
-fn gather_particles(parts: &mut [Particle], exists: &mut [bool], anc: &[u32], all: bool) {
+///
+/// `ALL` is a constant so that each variant's loops carry no flag (it spilled).
+fn gather_particles<const ALL: bool>(parts: &mut [Particle], exists: &mut [bool], anc: &[u32]) {
+    let all = ALL;
     #[inline(always)]
     fn copy(parts: &mut [Particle], exists: &mut [bool], j: usize, a: usize, all: bool) {
         let e = match exists.get(a) {
@@ -463,19 +469,24 @@ fn risk_pass(
     rng_out: &mut Rng,
 ) -> f32 {
     let zz_floor = zz.max(f32::MIN_POSITIVE);
-    let draw = ExistenceDraw::new(&model.chain);
+    let draw_table = ExistenceDraw::new(&model.chain);
+    // Through an opaque reference the two thresholds are read from memory by one
+    // indexed load per particle, instead of being held in two (spilled) registers and
+    // selected.
+    let draw = core::hint::black_box(&draw_table);
     let mut rng = rng_out.clone();
     let mut dmin = f32::INFINITY;
-    let mut n_absent = 0u32;
-    for (i, (&e, o)) in exists.iter().zip(out.iter_mut()).enumerate() {
+    // Present particles are counted (not absent ones), and the three arrays are zipped
+    // (no index, no bounds check), so the loop over mostly absent particles keeps
+    // everything in registers.
+    let mut n_present = 0usize;
+    let n = exists.len().min(out.len()).min(parts.len());
+    for ((&e, o), p) in exists.iter().zip(out.iter_mut()).zip(parts.iter()) {
         if draw.next(e, &mut rng) {
-            let x = match parts.get(i) {
-                Some(p) => &p.x,
-                None => break,
-            };
-            let (r, d2) = risk_present(model, z, zz, x, e, rng);
+            let (r, d2) = risk_present(model, z, zz, &p.x, e, rng);
             rng = r;
             *o = d2;
+            n_present += 1;
             // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never
             // NaN.
             if d2 < dmin {
@@ -483,10 +494,9 @@ fn risk_pass(
             }
         } else {
             *o = zz_floor;
-            n_absent += 1;
         }
     }
-    if n_absent > 0 && zz_floor < dmin {
+    if n_present < n && zz_floor < dmin {
         dmin = zz_floor;
     }
     *rng_out = rng;
@@ -633,7 +643,11 @@ impl<const N: usize> CrpfTbd<N> {
                 &mut self.rng,
             ) {
                 let all = self.cfg.lambda > 0.0;
-                gather_particles(&mut self.parts, &mut self.exists, &self.anc, all);
+                if all {
+                    gather_particles::<true>(&mut self.parts, &mut self.exists, &self.anc);
+                } else {
+                    gather_particles::<false>(&mut self.parts, &mut self.exists, &self.anc);
+                }
             }
             return;
         }
@@ -677,7 +691,11 @@ impl<const N: usize> CrpfTbd<N> {
         // the particles are kept as they are (identity resampling).
         if ok && resample(Scheme::Systematic, &self.w, &mut self.anc, &mut self.rng).is_ok() {
             let all = self.cfg.lambda > 0.0;
-            gather_particles(&mut self.parts, &mut self.exists, &self.anc, all);
+            if all {
+                gather_particles::<true>(&mut self.parts, &mut self.exists, &self.anc);
+            } else {
+                gather_particles::<false>(&mut self.parts, &mut self.exists, &self.anc);
+            }
         }
     }
 
@@ -709,16 +727,21 @@ impl<const N: usize> CrpfTbd<N> {
         let mut best = f32::INFINITY;
         let mut arg = None;
         let mut rng = self.rng.clone();
-        let draw = ExistenceDraw::new(&self.model.chain);
+        let draw_table = ExistenceDraw::new(&self.model.chain);
+        // Opaque reference: one indexed load per particle (see `risk_pass`).
+        let draw = core::hint::black_box(&draw_table);
         // With lambda = 0 an absent particle's state is never read again: only its flag
         // is written.
         let keep_absent = self.cfg.lambda > 0.0;
-        for (i, flag) in self.exists.iter_mut().enumerate() {
+        // Flags and states zipped: no index bounds check in the loop.
+        for (i, (flag, slot)) in self
+            .exists
+            .iter_mut()
+            .zip(self.parts.iter_mut())
+            .enumerate()
+        {
             let e = *flag;
             if draw.next(e, &mut rng) {
-                let Some(slot) = self.parts.get_mut(i) else {
-                    break;
-                };
                 let (r, log_c) = ctx.update_present(slot, e, rng);
                 rng = r;
                 if let Some(log_c) = log_c {
@@ -736,15 +759,13 @@ impl<const N: usize> CrpfTbd<N> {
             }
             *flag = false;
             if keep_absent {
-                if let Some(slot) = self.parts.get_mut(i) {
-                    // E = 0: x = 0, h = 0, C = lambda Cbar + ||z||^p.
-                    *slot = Particle {
-                        x: [0.0; 3],
-                        log_c: log_cost(&self.cfg, zz_floor, slot.log_c, ln_lambda),
-                        zh: Complex32::new(0.0, 0.0),
-                        hh: 0.0,
-                    };
-                }
+                // E = 0: x = 0, h = 0, C = lambda Cbar + ||z||^p.
+                *slot = Particle {
+                    x: [0.0; 3],
+                    log_c: log_cost(&self.cfg, zz_floor, slot.log_c, ln_lambda),
+                    zh: Complex32::new(0.0, 0.0),
+                    hh: 0.0,
+                };
             }
         }
         self.rng = rng;
