@@ -129,7 +129,7 @@ fn raw_instructions<R>(f: impl FnOnce() -> R) -> (R, u32) {
 #[derive(Debug, Clone, Copy)]
 pub struct Measurement {
     /// Executed instructions of the closure (empty-closure baseline subtracted).
-    pub instructions: u32,
+    pub instructions: u64,
     /// Peak stack below the caller's frame while the closure ran, in bytes (includes a
     /// few words of harness overhead; values up to 64 mean "at most 64").
     pub stack_bytes: u32,
@@ -144,7 +144,7 @@ pub fn measure<R>(f: impl FnOnce() -> R) -> (R, Measurement) {
     let (r, total) = raw_instructions(f);
     let stack_bytes = (sp - lowest_touched(lo, sp - PAINT_MARGIN)) as u32;
     let m = Measurement {
-        instructions: total.saturating_sub(BASELINE.load(Ordering::Relaxed)),
+        instructions: u64::from(total.saturating_sub(BASELINE.load(Ordering::Relaxed))),
         stack_bytes,
     };
     (r, m)
@@ -192,7 +192,7 @@ pub fn calibrate() {
 
 /// One copy of the measuring code for both loop lengths, so they differ only in `n`.
 #[inline(never)]
-fn measure_spin(n: u32) -> u32 {
+fn measure_spin(n: u32) -> u64 {
     let n = black_box(n);
     measure(|| spin(n)).1.instructions
 }
@@ -223,7 +223,7 @@ pub fn table_header() {
 pub fn row(name: &str, n: u32, unit: &str, m: Measurement, ram_bytes: usize) {
     let n = n.max(1);
     // One decimal, in integers (no float formatting differences between runs).
-    let tenths = (m.instructions as u64 * 10 + n as u64 / 2) / n as u64;
+    let tenths = (m.instructions * 10 + n as u64 / 2) / n as u64;
     hprintln!(
         "| {} | {} | {} | {}.{} / {} | {} | {} |",
         name,

@@ -75,7 +75,7 @@ pub fn run() {
         let (r, m) = measure(|| det.step(&buf[..n]));
         check(r);
         if s >= 2 {
-            sum += u64::from(m.instructions);
+            sum += m.instructions;
             plots += n as u32;
             if m.instructions > worst.instructions {
                 worst = m;
@@ -83,7 +83,7 @@ pub fn run() {
         }
     }
     let mean = Measurement {
-        instructions: (sum / 27) as u32,
+        instructions: sum / 27,
         stack_bytes: worst.stack_bytes,
     };
     row(

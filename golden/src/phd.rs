@@ -206,6 +206,7 @@ pub fn config(
             mode: BirthMode::Measurement {
                 cells: 8,
                 tangential_std: 40.0,
+                pair_max_speed: 0.0,
             },
             particles: births,
             mass: 0.02 * BIRTHS.len() as f32,
