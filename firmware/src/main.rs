@@ -38,9 +38,9 @@ fn main() -> ! {
         harness::static_ram()
     );
     hprintln!();
-    let mut line = Line::new();
+    let mut line = harness::Text::<1024>::new();
     faint_golden::cases(&mut |name, words| {
-        line.len = 0;
+        line.clear();
         if faint_golden::write_line(&mut line, name, words).is_err() {
             hprintln!("golden {} <line too long>", name);
         } else {
@@ -49,33 +49,4 @@ fn main() -> ! {
     });
     hprintln!("done");
     harness::exit_success()
-}
-
-/// Fixed buffer for one golden line (so the host and the firmware share the formatter).
-struct Line {
-    buf: [u8; 1024],
-    len: usize,
-}
-
-impl Line {
-    const fn new() -> Self {
-        Self {
-            buf: [0; 1024],
-            len: 0,
-        }
-    }
-
-    fn as_str(&self) -> &str {
-        core::str::from_utf8(&self.buf[..self.len]).unwrap_or("<utf8>")
-    }
-}
-
-impl core::fmt::Write for Line {
-    fn write_str(&mut self, s: &str) -> core::fmt::Result {
-        let end = self.len + s.len();
-        let dst = self.buf.get_mut(self.len..end).ok_or(core::fmt::Error)?;
-        dst.copy_from_slice(s.as_bytes());
-        self.len = end;
-        Ok(())
-    }
 }

@@ -159,39 +159,10 @@ fn measure_long<R>(f: impl FnOnce() -> R) -> (R, Measurement) {
 }
 
 fn hprintln_row(name: &str, what: &str, frames: usize, n: u32, m: Measurement) {
-    let mut label = Label::new();
+    let mut label = crate::harness::Text::<128>::new();
     let _ = core::fmt::Write::write_fmt(
         &mut label,
         format_args!("{name} step, {what} 0-{} (32^3 cells)", frames - 1),
     );
     row(label.as_str(), n, "particle", m, RAM);
-}
-
-/// A small fixed string for row labels.
-struct Label {
-    buf: [u8; 128],
-    len: usize,
-}
-
-impl Label {
-    const fn new() -> Self {
-        Self {
-            buf: [0; 128],
-            len: 0,
-        }
-    }
-
-    fn as_str(&self) -> &str {
-        core::str::from_utf8(&self.buf[..self.len]).unwrap_or("<utf8>")
-    }
-}
-
-impl core::fmt::Write for Label {
-    fn write_str(&mut self, s: &str) -> core::fmt::Result {
-        let end = self.len + s.len();
-        let dst = self.buf.get_mut(self.len..end).ok_or(core::fmt::Error)?;
-        dst.copy_from_slice(s.as_bytes());
-        self.len = end;
-        Ok(())
-    }
 }

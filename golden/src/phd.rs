@@ -148,30 +148,7 @@ pub fn cube(g: &CubeGeometry, k: usize, rng: &mut Rng, out: &mut [f32]) {
     }
 }
 
-/// Which of the paper's three algorithms.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Variant {
-    /// SMC-PHD TBD without PSO, K-means extraction.
-    PhdTbd,
-    /// PSO-PHD-TBD with K-means extraction.
-    PsoKMeans,
-    /// PSO-PHD-TBD with DBSCAN extraction.
-    PsoDbscan,
-}
-
-impl Variant {
-    /// All three, in the paper's order.
-    pub const ALL: [Variant; 3] = [Variant::PhdTbd, Variant::PsoKMeans, Variant::PsoDbscan];
-
-    /// Short name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Variant::PhdTbd => "PHD-TBD",
-            Variant::PsoKMeans => "PSO-PHD-TBD (K-means)",
-            Variant::PsoDbscan => "PSO-PHD-TBD (DBSCAN)",
-        }
-    }
-}
+pub use faint_core::detect::phd::Variant;
 
 /// The `six-targets` preset's filter settings in window `g`, with `particles_per_target`
 /// particles per estimated target, `births` birth particles per frame (also the minimum

@@ -100,30 +100,7 @@ pub const TABLE1: [TargetSpec; 6] = [
     },
 ];
 
-/// Which of the paper's three algorithms.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub enum Variant {
-    /// SMC-PHD TBD without PSO, K-means extraction.
-    PhdTbd,
-    /// PSO-PHD-TBD with K-means extraction.
-    PsoKMeans,
-    /// PSO-PHD-TBD with DBSCAN extraction (the paper's proposal).
-    PsoDbscan,
-}
-
-impl Variant {
-    /// All three, in the paper's order.
-    pub const ALL: [Variant; 3] = [Variant::PhdTbd, Variant::PsoKMeans, Variant::PsoDbscan];
-
-    /// Display name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Variant::PhdTbd => "PHD-TBD",
-            Variant::PsoKMeans => "PSO-PHD-TBD (K-means)",
-            Variant::PsoDbscan => "PSO-PHD-TBD (DBSCAN)",
-        }
-    }
-}
+pub use faint_core::detect::phd::Variant;
 
 /// The preset.
 #[derive(Debug, Clone, Serialize)]

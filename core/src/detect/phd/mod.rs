@@ -14,6 +14,7 @@ pub mod dbscan;
 pub mod kmeans;
 pub mod pso;
 pub mod smc_phd;
+mod variant;
 
 pub use dbscan::{Dbscan, DbscanParams};
 pub use kmeans::KMeans;
@@ -22,3 +23,4 @@ pub use smc_phd::{
     BirthComponent, BirthMode, BirthModel, Config, Estimate, Extractor, Report, SmcPhdTbd,
     MAX_BIRTH_COMPONENTS,
 };
+pub use variant::Variant;
