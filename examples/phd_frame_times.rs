@@ -42,6 +42,11 @@ fn thread_cpu_ns() -> u64 {
 fn run() {
     let which = std::env::args().nth(1).filter(|w| w != "all");
     let force = std::env::args().nth(2).as_deref() == Some("force");
+    // `FAINT_RUNS=1` (first run only) keeps instruction profiles (callgrind) short.
+    let runs: u64 = std::env::var("FAINT_RUNS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(3);
     let sc = SixTargets::new(9.0);
     for v in Variant::ALL {
         let tag = match v {
@@ -54,7 +59,7 @@ fn run() {
         }
         let mut times = Vec::new();
         let mut hash = 0x811C_9DC5u32;
-        for seed in 0..3u64 {
+        for seed in 0..runs {
             let mut rng = Rng::seed_from_u64(70 + seed);
             let truth = sc.truth(&mut rng);
             let mut cfg = sc.config(v);

@@ -210,3 +210,69 @@ fn crowding_gives_boundaries_the_maximum_and_inner_points_the_weighted_gap() {
     assert!((crowd[1] - 2.0 * 3.0 / 6.0).abs() < 1e-6);
     assert!((crowd[2] - 2.0 * 5.0 / 6.0).abs() < 1e-6);
 }
+
+#[test]
+fn divide_and_conquer_ranks_match_brute_force_with_ties_and_many_objectives() {
+    // Random sets with few levels (many ties and duplicates) and with many levels, up to
+    // 8 objectives, sizes around the small-case cut-offs and well above them.
+    use faint::core::detect::phd::ndsort::{rank_sorted, Workspace};
+    let mut rng = Rng::seed_from_u64(78);
+    for case in 0..300 {
+        let n = 1 + rng.below(if case % 3 == 0 { 600 } else { 120 }) as usize;
+        let m = 1 + rng.below(8) as usize;
+        let levels = [3.0f32, 6.0, 1000.0][rng.below(3) as usize];
+        let mut f: Vec<[f32; 8]> = (0..n)
+            .map(|_| {
+                let mut v = [0.0f32; 8];
+                for x in v.iter_mut() {
+                    *x = (rng.uniform() * levels).floor() / levels;
+                }
+                v
+            })
+            .collect();
+        // Lexicographically descending on the first m objectives.
+        f.sort_by(|a, b| {
+            for j in 0..m {
+                match b[j].partial_cmp(&a[j]).unwrap() {
+                    std::cmp::Ordering::Equal => continue,
+                    o => return o,
+                }
+            }
+            std::cmp::Ordering::Equal
+        });
+        let (mut rank, mut work, mut scratch, mut ord1) =
+            (vec![0u32; n], vec![0u32; n], vec![0u32; n], vec![0u32; n]);
+        // Garbage in the Fenwick workspace: the sort must clear it itself.
+        let mut fen = vec![7u32; n];
+        let ws = Workspace {
+            work: &mut work,
+            scratch: &mut scratch,
+            order1: &mut ord1,
+            fenwick: &mut fen,
+        };
+        let fronts = rank_sorted(n, m, |p, j| f[p][j], &mut rank, ws);
+        let f4: Vec<[f32; 8]> = f.clone();
+        let want = brute_ranks_n(&f4, m);
+        assert_eq!(rank, want, "case {case} (n={n}, m={m}, levels={levels})");
+        assert_eq!(fronts as u32, want.iter().max().unwrap() + 1);
+    }
+}
+
+fn brute_ranks_n(f: &[[f32; 8]], m: usize) -> Vec<u32> {
+    let n = f.len();
+    let mut rank = vec![u32::MAX; n];
+    let mut r = 0;
+    while rank.contains(&u32::MAX) {
+        let cur: Vec<usize> = (0..n)
+            .filter(|&i| {
+                rank[i] == u32::MAX
+                    && !(0..n).any(|j| rank[j] == u32::MAX && dominates(&f[j][..m], &f[i][..m]))
+            })
+            .collect();
+        for i in cur {
+            rank[i] = r;
+        }
+        r += 1;
+    }
+    rank
+}

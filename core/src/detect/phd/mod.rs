@@ -6,12 +6,14 @@
 //!
 //! - [`smc_phd`]: the filter ([`SmcPhdTbd`], [`Config`], [`Report`]).
 //! - [`pso`]: swarm, ENS-BS non-dominated sort (O(N) memory), weighted crowding.
+//! - [`ndsort`]: divide-and-conquer non-dominated sort for three or more objectives.
 //! - [`dbscan`]: grid-indexed DBSCAN.
 //! - [`kmeans`]: deterministic K-means.
 //! - the observation model lives in [`crate::model::power_cube`].
 
 pub mod dbscan;
 pub mod kmeans;
+pub mod ndsort;
 pub mod pso;
 pub mod smc_phd;
 mod variant;

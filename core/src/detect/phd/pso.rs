@@ -4,16 +4,23 @@
 //!
 //! All objectives are **maximised** (fitness values in `[0, 1]`).
 //!
-//! Non-dominated sorting uses ENS-BS (Zhang, Tian, Cheng, Jin, "An efficient approach to
-//! nondominated sorting for evolutionary multiobjective optimization", IEEE TEVC 2015):
-//! solutions are visited in lexicographic order (so none can be dominated by a later
-//! one), and each is placed by binary search over the fronts found so far, checking the
-//! members of a front newest first. Fronts are kept as linked lists through one `next`
-//! array, so memory is O(N) (no N^2 domination lists); the worst-case time is
-//! O(M N^2), typical O(M N log N).
+//! Non-dominated sorting, all exact and O(N) memory (no N^2 domination lists):
+//! - [`non_dominated_sort`] (public, any number of objectives) and the swarm's groups with
+//!   two active objectives: ENS-BS (Zhang, Tian, Cheng, Jin, "An efficient approach to
+//!   nondominated sorting for evolutionary multiobjective optimization", IEEE TEVC 2015):
+//!   solutions are visited in lexicographic order (so none can be dominated by a later
+//!   one), and each is placed by binary search over the fronts found so far, checking the
+//!   members of a front newest first; fronts are linked lists through one `next` array.
+//!   Worst case O(M N^2); with at most two objectives only the newest member of a front
+//!   needs checking, O(N log N).
+//! - the swarm's groups with three or more active objectives: the divide-and-conquer
+//!   sort of [`super::ndsort`], O(N log^(M-1) N) whatever the front sizes (ENS-BS spent
+//!   70 % of the frame there: those groups' first fronts hold most of their entries).
+//! - one active objective: the best half by that objective (a selection, O(N)).
 
 #![allow(clippy::needless_range_loop)]
 
+use super::ndsort;
 use crate::math;
 use crate::rng::Rng;
 
@@ -49,6 +56,8 @@ fn lex_desc(a: &[f32], b: &[f32]) -> core::cmp::Ordering {
 /// Writes the front index (0 = non-dominated) of each solution into `rank[..n]` and
 /// returns the number of fronts. Workspace: `order`, `next`, `head` of length `>= n`.
 /// Objective values must be finite (NaN compares as "equal" and does not panic).
+/// With `m <= 2` only each front's newest member is checked (see [`ens_bs`]), so the
+/// sort is O(N log N) whatever the front sizes.
 pub fn non_dominated_sort<const M: usize>(
     f: &[[f32; M]],
     m: usize,
@@ -70,16 +79,39 @@ pub fn non_dominated_sort<const M: usize>(
     order[..n].sort_unstable_by(|&a, &b| {
         lex_desc(&f[a as usize][..m], &f[b as usize][..m]).then(a.cmp(&b))
     });
+    ens_bs(&order[..n], m <= 2, rank, next, head, |a, b| {
+        dominates(&f[a][..m], &f[b][..m])
+    })
+}
+
+/// Front assignment of ENS-BS. `order` lists solution ids best first in lexicographic
+/// order (so no solution is dominated by a later one); `dom(a, b)`: `a` dominates `b`.
+/// `rank` and `next` are indexed by solution id, `head[..order.len()]` by front; fronts
+/// are linked lists (newest first) through `next`. Returns the number of fronts.
+///
+/// `newest_only` (valid for at most two objectives): in lexicographic order the members
+/// of one front have non-increasing `f_1` and non-decreasing `f_2`, so a later solution
+/// is dominated by some member iff it is dominated by the newest one.
+fn ens_bs(
+    order: &[u32],
+    newest_only: bool,
+    rank: &mut [u32],
+    next: &mut [u32],
+    head: &mut [u32],
+    dom: impl Fn(usize, usize) -> bool,
+) -> usize {
     let mut fronts = 0usize;
-    for k in 0..n {
-        let s = order[k] as usize;
-        let fs = &f[s][..m];
+    for &s in order {
+        let s = s as usize;
         // Is s dominated by some member of front `j`?
         let dominated_by = |j: usize, head: &[u32], next: &[u32]| {
             let mut t = head[j];
             while t != NONE {
-                if dominates(&f[t as usize][..m], fs) {
+                if dom(t as usize, s) {
                     return true;
+                }
+                if newest_only {
+                    return false;
                 }
                 t = next[t as usize];
             }
@@ -108,7 +140,8 @@ pub fn non_dominated_sort<const M: usize>(
 
 /// Weighted crowding distance (eq. 10-12): per front and objective `j`, sorted by
 /// `f_j`, the two ends get `boundary` and inner solutions get
-/// `sum_j W_j (f_j[next] - f_j[prev]) / (f_j,max - f_j,min)` (a zero span adds nothing).
+/// `sum_j W_j (f_j[next] - f_j[prev]) / (f_j,max - f_j,min)`. An objective on which the
+/// front has zero span adds nothing, not even boundaries (its "ends" would be arbitrary).
 ///
 /// `order` is a workspace of length `>= n`.
 pub fn crowding_distance<const M: usize>(
@@ -146,9 +179,9 @@ pub fn crowding_distance<const M: usize>(
             let lo = f[order[s] as usize][j];
             let hi = f[order[e - 1] as usize][j];
             let span = hi - lo;
-            crowd[order[s] as usize] = boundary;
-            crowd[order[e - 1] as usize] = boundary;
             if span > 0.0 {
+                crowd[order[s] as usize] = boundary;
+                crowd[order[e - 1] as usize] = boundary;
                 for k in s + 1..e.saturating_sub(1) {
                     let i = order[k] as usize;
                     if crowd[i] < boundary {
@@ -235,10 +268,14 @@ pub struct Swarm<const S: usize, const M: usize> {
     /// Selection group of each entry (the caller's target group; children inherit it).
     group: [u16; S],
     rank: [u32; S],
-    crowd: [f32; S],
+    /// Crowding distance as `f32` bits (non-negative, so the bits order like the values);
+    /// the divide-and-conquer sort's Fenwick tree while ranks are computed.
+    crowd: [u32; S],
     order: [u32; S],
     next: [u32; S],
     head: [u32; S],
+    aux: [u32; S],
+    kept: [bool; S],
     /// Active entries (parents) after [`Swarm::run`].
     pub len: usize,
 }
@@ -271,10 +308,12 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             src: [0; S],
             group: [0; S],
             rank: [0; S],
-            crowd: [0.0; S],
+            crowd: [0; S],
             order: [0; S],
             next: [0; S],
             head: [0; S],
+            aux: [0; S],
+            kept: [false; S],
             len: 0,
         }
     }
@@ -310,16 +349,18 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     }
 
     /// Objective values of eq. 18 for entry `i`; returns the eq. 19 total (`w_m = 1/m`).
-    fn evaluate(&mut self, i: usize, points: &[[f32; 2]], inv_two_s2: f32, floor: f32) -> f32 {
+    ///
+    /// `f_m = exp(-d^2 inv_two_s2)`, set to 0 where `d^2 inv_two_s2 > cut = -ln(gate)`
+    /// (below the gate): far points then tie exactly, so each particle has only the few
+    /// objectives of the points near it, and no `exp` is spent on the others.
+    fn evaluate(&mut self, i: usize, points: &[[f32; 2]], inv_two_s2: f32, cut: f32) -> f32 {
         let p = self.pos[i];
         let mut total = 0.0;
         for (m, z) in points.iter().enumerate().take(M) {
             let dx = p[0] - z[0];
             let dy = p[1] - z[1];
-            let v = math::exp(-(dx * dx + dy * dy) * inv_two_s2);
-            // Values below the floor are set to 0: far points then tie exactly, so the
-            // sort decomposes per point (few, short fronts instead of one huge one).
-            let v = if v < floor { 0.0 } else { v };
+            let a = (dx * dx + dy * dy) * inv_two_s2;
+            let v = if a > cut { 0.0 } else { math::exp(-a) };
             self.fit[i][m] = v;
             total += v;
         }
@@ -348,9 +389,13 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     /// Runs the multi-objective PSO on the parents `0..len` towards `points`:
     /// per generation, children by eq. 8-9 plus mutation (entry `i % 3`: 0 unchanged,
     /// 1 one common uniform increment, 2 an own uniform increment), fitness eq. 18-19,
-    /// merge, non-dominated sort, weighted crowding, keep the best `len` by
-    /// (front, crowding). Runs `generations`, then continues while the mean
-    /// best-objective fitness is below `threshold`, at most `max_generations` in all. Weights ride along; the caller renormalises.
+    /// merge, and the elitist selection of [`Swarm::select`]. Runs `generations`, then
+    /// continues while the mean best-objective fitness is below `threshold`, at most
+    /// `max_generations` in all. Weights ride along; the caller renormalises.
+    ///
+    /// The leader of objective `j` (the `gBest` of eq. 8 for the particles whose best
+    /// objective is `j`) is the parent with the largest `f_j` (ties: larger eq. 19 total,
+    /// then lower index), which is always on the first front.
     pub fn run(&mut self, cfg: &PsoConfig, points: &[[f32; 2]], rng: &mut Rng) -> SwarmReport {
         let n = self.len;
         let m = points.len().min(M);
@@ -358,36 +403,30 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             return SwarmReport::default();
         }
         let inv_two_s2 = 1.0 / (2.0 * cfg.fitness_scale * cfg.fitness_scale);
+        let cut = -math::ln(cfg.gate);
         let mut mean_best = 0.0f32;
         for i in 0..n {
-            self.evaluate(i, points, inv_two_s2, cfg.gate);
+            self.evaluate(i, points, inv_two_s2, cut);
             mean_best += self.best_objective(i, m).1;
         }
         mean_best /= n as f32;
-        let obj_w = [1.0f32 / m as f32; M];
+        let obj_w = 1.0f32 / m as f32;
         let mut gens = 0usize;
         let cap = cfg.max_generations.max(cfg.generations);
         while gens < cap && (gens < cfg.generations || mean_best < cfg.threshold) {
             gens += 1;
-            // Leaders: per objective, the front-0 entry with the highest value.
-            let fronts = non_dominated_sort(
-                &self.fit[..n],
-                m,
-                &mut self.rank[..n],
-                &mut self.order[..n],
-                &mut self.next[..n],
-                &mut self.head[..n],
-            );
-            let _ = fronts;
             let mut leader = [0usize; M];
-            let mut lval = [f32::NEG_INFINITY; M];
+            let mut lval = [(f32::NEG_INFINITY, f32::NEG_INFINITY); M];
             for i in 0..n {
-                if self.rank[i] == 0 {
-                    for j in 0..m {
-                        if self.fit[i][j] > lval[j] {
-                            lval[j] = self.fit[i][j];
-                            leader[j] = i;
-                        }
+                let mut tot = 0.0f32;
+                for j in 0..m {
+                    tot += self.fit[i][j];
+                }
+                for j in 0..m {
+                    let v = (self.fit[i][j], tot);
+                    if v.0 > lval[j].0 || (v.0 == lval[j].0 && v.1 > lval[j].1) {
+                        lval[j] = v;
+                        leader[j] = i;
                     }
                 }
             }
@@ -426,83 +465,305 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
                 self.weight[c] = self.weight[i];
                 self.src[c] = self.src[i];
                 self.group[c] = self.group[i];
-                self.evaluate(c, points, inv_two_s2, cfg.gate);
+                self.evaluate(c, points, inv_two_s2, cut);
             }
-            // Elitist selection over parents + children.
-            let tot = 2 * n;
-            non_dominated_sort(
-                &self.fit[..tot],
-                m,
-                &mut self.rank[..tot],
-                &mut self.order[..tot],
-                &mut self.next[..tot],
-                &mut self.head[..tot],
-            );
-            crowding_distance(
-                &self.fit[..tot],
-                m,
-                &obj_w[..m],
-                &self.rank[..tot],
-                f32::MAX,
-                &mut self.crowd[..tot],
-                &mut self.order[..tot],
-            );
-            {
-                let (rank, crowd, group) = (&self.rank, &self.crowd, &self.group);
-                self.order[..tot].sort_unstable_by(|&a, &b| {
-                    let (a, b) = (a as usize, b as usize);
-                    group[a]
-                        .cmp(&group[b])
-                        .then(rank[a].cmp(&rank[b]))
-                        .then(
-                            crowd[b]
-                                .partial_cmp(&crowd[a])
-                                .unwrap_or(core::cmp::Ordering::Equal),
-                        )
-                        .then(a.cmp(&b))
-                });
-            }
-            // Per group, keep the best `parents of the group` entries (a global cut
-            // would keep the groups whose fronts are wide, i.e. targets near several
-            // points, and drop the others' particles: measured, a target with one
-            // point lost 99.9 % of its swarm entries in one frame). Every parent and
-            // child of group g sits in the contiguous run of g in `order`, and the run
-            // holds twice the group's parents, so `kept` ends at n.
-            let mut kept = 0usize;
-            let mut s0 = 0usize;
-            while s0 < tot {
-                let gi = self.group[self.order[s0] as usize];
-                let mut e0 = s0;
-                while e0 < tot && self.group[self.order[e0] as usize] == gi {
-                    e0 += 1;
-                }
-                let keep = (e0 - s0) / 2;
-                for t in s0..s0 + keep {
-                    self.order[kept] = self.order[t];
-                    kept += 1;
-                }
-                s0 = e0;
-            }
-            // Compacted in ascending index order (safe forward copy).
-            self.order[..kept].sort_unstable();
+            self.select(2 * n, m, obj_w);
+            // Compact the kept entries in ascending index order (safe forward copy).
+            let mut k = 0usize;
             mean_best = 0.0;
-            for k in 0..n {
-                let s = self.order[k] as usize;
-                self.pos[k] = self.pos[s];
-                self.vel[k] = self.vel[s];
-                self.pbest[k] = self.pbest[s];
-                self.pbest_fit[k] = self.pbest_fit[s];
-                self.fit[k] = self.fit[s];
-                self.weight[k] = self.weight[s];
-                self.src[k] = self.src[s];
-                self.group[k] = self.group[s];
+            for s in 0..2 * n {
+                if !self.kept[s] {
+                    continue;
+                }
+                if k != s {
+                    self.pos[k] = self.pos[s];
+                    self.vel[k] = self.vel[s];
+                    self.pbest[k] = self.pbest[s];
+                    self.pbest_fit[k] = self.pbest_fit[s];
+                    self.fit[k] = self.fit[s];
+                    self.weight[k] = self.weight[s];
+                    self.src[k] = self.src[s];
+                    self.group[k] = self.group[s];
+                }
                 mean_best += self.best_objective(k, m).1;
+                k += 1;
             }
             mean_best /= n as f32;
         }
         SwarmReport {
             generations: gens,
             mean_fitness: mean_best,
+        }
+    }
+
+    /// Elitist selection over entries `0..tot` (parents and children): per selection
+    /// group, keep the best half by (front, weighted crowding distance eq. 10-12), ties by
+    /// lower index; writes `kept`.
+    ///
+    /// Sorting and crowding run per group, over the group's *active* objectives only
+    /// (those some member has above the gate): the selection is per group (a global cut
+    /// would keep the groups whose fronts are wide, i.e. targets near several points, and
+    /// drop the others' particles: measured, a target with one point lost 99.9 % of its
+    /// swarm entries in one frame), an objective that is 0 for the whole group neither
+    /// dominates nor crowds, and dominance by another group's entries would only reorder
+    /// fronts that are cut per group anyway. Group ids `>= M` share group `M - 1`.
+    /// A group with one active objective keeps its best half by that objective (its
+    /// fronts are the distinct values and crowding adds nothing), with two the sort checks
+    /// one member per front, so the selection is O(N log N) whatever the front sizes;
+    /// with three or more it is ENS-BS on the group. Only the front that is cut gets
+    /// crowding distances (NSGA-II), since the fronts before it are kept whole.
+    fn select(&mut self, tot: usize, m: usize, obj_w: f32) {
+        // Counting sort of the entries by group into `order`.
+        let mut start = [0usize; M];
+        for i in 0..tot {
+            start[(self.group[i] as usize).min(M - 1)] += 1;
+        }
+        let mut acc = 0usize;
+        for c in start.iter_mut() {
+            let k = *c;
+            *c = acc;
+            acc += k;
+        }
+        let mut end = start;
+        // Active objectives per group: some member has the objective above the gate.
+        let mut active = [[false; M]; M];
+        for i in 0..tot {
+            let g = (self.group[i] as usize).min(M - 1);
+            self.order[end[g]] = i as u32;
+            end[g] += 1;
+            self.kept[i] = false;
+            for (a, &v) in active[g][..m].iter_mut().zip(&self.fit[i][..m]) {
+                *a |= v > 0.0;
+            }
+        }
+        for g in 0..M {
+            let (s, e) = (start[g], end[g]);
+            let keep = (e - s) / 2;
+            if keep == 0 {
+                continue;
+            }
+            // Active objectives of the group, the group's own point first (any objective
+            // order gives the same fronts; with its own point first, whose fitness few
+            // members lack, the lexicographic sort rarely needs a second objective).
+            let mut act = [0usize; M];
+            let mut na = 0usize;
+            if g < m && active[g][g] {
+                act[0] = g;
+                na = 1;
+            }
+            for j in 0..m {
+                if active[g][j] && !(na > 0 && act[0] == j) {
+                    act[na] = j;
+                    na += 1;
+                }
+            }
+            let act = &act[..na];
+            let fit = &self.fit;
+            if na <= 1 {
+                // Fronts are the distinct values of the one objective, best first.
+                let key = |i: u32| {
+                    if na == 1 {
+                        fit[i as usize][act[0]]
+                    } else {
+                        0.0
+                    }
+                };
+                self.order[s..e].select_nth_unstable_by(keep - 1, |&a, &b| {
+                    key(b)
+                        .partial_cmp(&key(a))
+                        .unwrap_or(core::cmp::Ordering::Equal)
+                        .then(a.cmp(&b))
+                });
+                for &i in &self.order[s..s + keep] {
+                    self.kept[i as usize] = true;
+                }
+                continue;
+            }
+            // Lexicographically descending on the active objectives, ties by index; the
+            // first objective as a precomputed key.
+            let j0 = act[0];
+            for &i in &self.order[s..e] {
+                self.aux[i as usize] = !ndsort::ordered_bits(fit[i as usize][j0]);
+            }
+            let key = &self.aux;
+            self.order[s..e].sort_unstable_by(|&a, &b| {
+                key[a as usize].cmp(&key[b as usize]).then_with(|| {
+                    let (fa, fb) = (&fit[a as usize], &fit[b as usize]);
+                    for &j in &act[1..] {
+                        if fa[j] > fb[j] {
+                            return core::cmp::Ordering::Less;
+                        }
+                        if fa[j] < fb[j] {
+                            return core::cmp::Ordering::Greater;
+                        }
+                    }
+                    a.cmp(&b)
+                })
+            });
+            let (taken, cut_len) = if na == 2 {
+                self.fronts_two(s, e, keep, act)
+            } else {
+                self.fronts_many(s, e, keep, act)
+            };
+            if cut_len > 0 {
+                self.crowd_cut(s, cut_len, keep - taken, act, obj_w);
+            }
+        }
+    }
+
+    /// Two active objectives: ENS-BS over the group's lexicographic order in
+    /// `order[s..e]`, checking one member per front (O(N log N)). Marks the fronts that
+    /// fit in `keep` and copies the members of the front that is cut to `head[s..]`;
+    /// returns (kept, members of the cut front).
+    fn fronts_two(&mut self, s: usize, e: usize, keep: usize, act: &[usize]) -> (usize, usize) {
+        let fit = &self.fit;
+        let fronts = ens_bs(
+            &self.order[s..e],
+            true,
+            &mut self.rank,
+            &mut self.next,
+            &mut self.head[s..e],
+            |a, b| {
+                let (fa, fb) = (&fit[a], &fit[b]);
+                let mut strict = false;
+                for &j in act {
+                    if fa[j] < fb[j] {
+                        return false;
+                    }
+                    strict |= fa[j] > fb[j];
+                }
+                strict
+            },
+        );
+        let mut taken = 0usize;
+        for fr in 0..fronts {
+            let mut cnt = 0usize;
+            let mut t = self.head[s + fr];
+            while t != NONE {
+                cnt += 1;
+                t = self.next[t as usize];
+            }
+            let mut t = self.head[s + fr];
+            if taken + cnt <= keep {
+                while t != NONE {
+                    self.kept[t as usize] = true;
+                    t = self.next[t as usize];
+                }
+                taken += cnt;
+                if taken == keep {
+                    return (taken, 0);
+                }
+            } else {
+                // `head[s + fr]` was read: `head[s..]` is free for the members.
+                let mut c = 0usize;
+                while t != NONE {
+                    self.head[s + c] = t;
+                    c += 1;
+                    t = self.next[t as usize];
+                }
+                return (taken, c);
+            }
+        }
+        (taken, 0)
+    }
+
+    /// Three or more active objectives: ranks by [`ndsort::rank_sorted`] (position
+    /// ranks in `rank[s..e]`, workspaces `head`, `next`, `aux`, `crowd` over `s..e`), then as
+    /// [`Swarm::fronts_two`].
+    fn fronts_many(&mut self, s: usize, e: usize, keep: usize, act: &[usize]) -> (usize, usize) {
+        let len = e - s;
+        let (fit, order) = (&self.fit, &self.order);
+        let fronts = ndsort::rank_sorted(
+            len,
+            act.len(),
+            |p, j| fit[order[s + p] as usize][act[j]],
+            &mut self.rank[s..e],
+            ndsort::Workspace {
+                work: &mut self.head[s..e],
+                scratch: &mut self.next[s..e],
+                order1: &mut self.aux[s..e],
+                fenwick: &mut self.crowd[s..e],
+            },
+        );
+        // Front sizes (fronts <= len), then the front that is cut.
+        let count = &mut self.next[s..e];
+        for c in count[..fronts].iter_mut() {
+            *c = 0;
+        }
+        for &r in &self.rank[s..e] {
+            count[r as usize] += 1;
+        }
+        let mut taken = 0usize;
+        let mut cut = fronts;
+        for (fr, &c) in count[..fronts].iter().enumerate() {
+            if taken + c as usize > keep {
+                cut = fr;
+                break;
+            }
+            taken += c as usize;
+            if taken == keep {
+                cut = fr + 1;
+                break;
+            }
+        }
+        let collect = taken < keep;
+        let mut c = 0usize;
+        for p in 0..len {
+            let r = self.rank[s + p] as usize;
+            let i = self.order[s + p];
+            if r < cut {
+                self.kept[i as usize] = true;
+            } else if collect && r == cut {
+                self.head[s + c] = i;
+                c += 1;
+            }
+        }
+        (taken, c)
+    }
+
+    /// Crowding distance (eq. 10-12) over the `len` members of the cut front in
+    /// `head[s..s + len]`, on the active objectives; keeps the `need` most isolated
+    /// (ties: lower index).
+    fn crowd_cut(&mut self, s: usize, len: usize, need: usize, act: &[usize], obj_w: f32) {
+        let fit = &self.fit;
+        let members = &mut self.head[s..s + len];
+        for &i in members.iter() {
+            self.crowd[i as usize] = 0;
+        }
+        let boundary = f32::MAX.to_bits();
+        for &j in act {
+            // Ascending by `f_j`, ties by index.
+            for &i in members.iter() {
+                self.aux[i as usize] = ndsort::ordered_bits(fit[i as usize][j]);
+            }
+            let key = &self.aux;
+            members
+                .sort_unstable_by(|&a, &b| key[a as usize].cmp(&key[b as usize]).then(a.cmp(&b)));
+            let lo = fit[members[0] as usize][j];
+            let hi = fit[members[len - 1] as usize][j];
+            let span = hi - lo;
+            if span > 0.0 {
+                self.crowd[members[0] as usize] = boundary;
+                self.crowd[members[len - 1] as usize] = boundary;
+                for k in 1..len.saturating_sub(1) {
+                    let i = members[k] as usize;
+                    if self.crowd[i] < boundary {
+                        let d = fit[members[k + 1] as usize][j] - fit[members[k - 1] as usize][j];
+                        let c = f32::from_bits(self.crowd[i]) + obj_w * d / span;
+                        self.crowd[i] = c.to_bits();
+                    }
+                }
+            }
+        }
+        let crowd = &self.crowd;
+        if need == 0 || need > len {
+            return;
+        }
+        members.select_nth_unstable_by(need - 1, |&a, &b| {
+            crowd[b as usize].cmp(&crowd[a as usize]).then(a.cmp(&b))
+        });
+        for &i in &members[..need] {
+            self.kept[i as usize] = true;
         }
     }
 }
