@@ -29,3 +29,21 @@ fn reproduce_psophd_quick_writes_tables_and_plots() {
     assert_eq!(frames.lines().count(), 1 + 3 * 40);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn reproduce_psophd_rejects_bad_arguments_before_any_run() {
+    for (args, needle) in [
+        (vec!["--birth-pair-speed=-3"], "--birth-pair-speed"),
+        (vec!["--birth-pair-speed=inf"], "--birth-pair-speed"),
+        (vec!["--snr-db", "nan"], "--snr-db"),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_faint"))
+            .args(["--quiet", "reproduce", "psophd", "--runs", "100000"])
+            .args(&args)
+            .output()
+            .expect("run faint");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} accepted");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+    }
+}

@@ -39,6 +39,11 @@ pub struct Args {
     /// CI mode: 2 runs at 9 dB only.
     #[arg(long)]
     pub quick: bool,
+    /// Two-frame birth velocity (m/s, `pair_max_speed`): a birth particle's tangential
+    /// velocity from its displacement to a birth cell of the frame before, when the
+    /// speed is at most this; 0 (default) = off, `N(0, 40^2)` tangential velocity.
+    #[arg(long, default_value_t = 0.0)]
+    pub birth_pair_speed: f64,
 }
 
 /// The paper's numbers: (Table 2 PHD-TBD, Table 2 PSO, Table 3 x3, Table 4 PHD, PSO-DBSCAN).
@@ -129,6 +134,15 @@ fn mean_std(v: &[f64]) -> (f64, f64) {
 
 /// Runs the reproduction.
 pub fn run(args: &Args) -> Result<()> {
+    if !(args.birth_pair_speed.is_finite() && args.birth_pair_speed >= 0.0) {
+        anyhow::bail!(
+            "--birth-pair-speed must be a finite speed >= 0 m/s, got {}",
+            args.birth_pair_speed
+        );
+    }
+    if let Some(bad) = args.snr_db.iter().find(|s| !s.is_finite()) {
+        anyhow::bail!("--snr-db values must be finite, got {bad}");
+    }
     let (snrs, runs) = if args.quick {
         (vec![9.0], 2)
     } else {
@@ -142,7 +156,8 @@ pub fn run(args: &Args) -> Result<()> {
     let mut frames_csv = Vec::new();
     let mut summary = Vec::new();
     for &snr in &snrs {
-        let sc = SixTargets::new(snr);
+        let mut sc = SixTargets::new(snr);
+        sc.birth_pair_max_speed = args.birth_pair_speed;
         let label = format!("psophd {snr} dB");
         let seed = args.seed ^ (snr * 1000.0) as u64;
         let all: Vec<Result<Vec<RunResult>>> =

@@ -127,6 +127,9 @@ pub struct SixTargets {
     pub particles_per_target: usize,
     /// Birth particles per frame.
     pub birth_particles: usize,
+    /// Two-frame birth velocity: `BirthMode::Measurement::pair_max_speed` (m/s; 0 = off,
+    /// the preset's default; `faint reproduce psophd --birth-pair-speed`).
+    pub birth_pair_max_speed: f64,
     /// Targets.
     pub targets: Vec<TargetSpec>,
     /// DBSCAN radius `E` (m) and density threshold `Th_min`.
@@ -163,6 +166,7 @@ impl SixTargets {
             p_birth: 0.02,
             particles_per_target: 1000,
             birth_particles: 500,
+            birth_pair_max_speed: 0.0,
             targets: TABLE1.to_vec(),
             dbscan: (5.0, 10),
             ospa: (50.0, 2.0),
@@ -317,7 +321,7 @@ impl SixTargets {
                 mode: BirthMode::Measurement {
                     cells: 8,
                     tangential_std: 40.0,
-                    pair_max_speed: 0.0,
+                    pair_max_speed: self.birth_pair_max_speed as f32,
                 },
                 particles: self.birth_particles,
                 mass: 3.0 * self.p_birth as f32,
