@@ -1,5 +1,6 @@
 //! PSO-PHD-TBD building blocks against brute-force references: grid DBSCAN versus the
-//! O(N^2) textbook DBSCAN, ENS-BS non-dominated sorting versus O(N^2) peeling.
+//! O(N^2) textbook DBSCAN, ENS-BS and divide-and-conquer non-dominated sorting versus
+//! O(N^2) peeling; swarm invariants (proptest).
 
 use faint::core::detect::phd::dbscan::{Dbscan, DbscanParams, NOISE};
 use faint::core::detect::phd::pso::{crowding_distance, dominates, non_dominated_sort};
@@ -286,4 +287,74 @@ fn brute_ranks_n(f: &[[f32; 8]], m: usize) -> Vec<u32> {
         r += 1;
     }
     rank
+}
+
+mod swarm_props {
+    use faint::core::detect::phd::pso::{PsoConfig, Swarm};
+    use faint::core::rng::Rng;
+    use proptest::prelude::*;
+
+    type Sw = Swarm<1024, 8>;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+        /// Swarm invariants over random points and parents: the parent count and each
+        /// group's count are kept, every entry keeps its source's weight, positions and
+        /// fitness stay finite (fitness in [0, 1]), and the same seed gives the same swarm.
+        #[test]
+        fn swarm_keeps_counts_weights_and_is_deterministic(
+            seed in any::<u64>(),
+            n_points in 1usize..=8,
+            n in 1usize..400,
+            spread in 1.0f32..80.0,
+        ) {
+            let mut rng = Rng::seed_from_u64(seed);
+            let points: Vec<[f32; 2]> = (0..n_points)
+                .map(|_| [rng.uniform_range(0.0, 300.0), rng.uniform_range(0.0, 300.0)])
+                .collect();
+            let mut parents = Vec::new();
+            for i in 0..n {
+                let g = rng.below(n_points as u32) as usize;
+                let p = [
+                    points[g][0] + spread * rng.normal(),
+                    points[g][1] + spread * rng.normal(),
+                ];
+                parents.push((p, 0.5 + rng.uniform(), i as u32, g as u16));
+            }
+            let cfg = PsoConfig::paper();
+            let run = |s: u64| {
+                let mut sw = Box::new(Sw::new());
+                for &(p, w, src, g) in &parents {
+                    assert!(sw.push(p, w, src, g));
+                }
+                let rep = sw.run(&cfg, &points, &mut Rng::seed_from_u64(s));
+                (sw, rep)
+            };
+            let (a, rep) = run(seed ^ 1);
+            prop_assert_eq!(a.len, n);
+            prop_assert!(rep.generations >= cfg.generations.min(cfg.max_generations));
+            let mut per_group = vec![0usize; n_points];
+            let mut want = vec![0usize; n_points];
+            for &(_, _, _, g) in &parents {
+                want[g as usize] += 1;
+            }
+            for k in 0..a.len {
+                let src = a.src[k] as usize;
+                let (_, w, _, g) = parents[src];
+                per_group[g as usize] += 1;
+                prop_assert_eq!(a.weight[k], w);
+                prop_assert!(a.pos[k][0].is_finite() && a.pos[k][1].is_finite());
+                for &f in &a.fit[k][..n_points] {
+                    prop_assert!((0.0..=1.0).contains(&f));
+                }
+            }
+            prop_assert_eq!(per_group, want);
+            let (b, _) = run(seed ^ 1);
+            for k in 0..n {
+                prop_assert_eq!(a.pos[k][0].to_bits(), b.pos[k][0].to_bits());
+                prop_assert_eq!(a.pos[k][1].to_bits(), b.pos[k][1].to_bits());
+                prop_assert_eq!(a.src[k], b.src[k]);
+            }
+        }
+    }
 }
