@@ -94,10 +94,16 @@ pub fn rank_sorted<V: Fn(usize, usize) -> f32>(
             order1[p as usize] = d;
         }
     }
-    for f in fenwick[..n].iter_mut() {
-        *f = 0;
+    // Unique vectors only; duplicates copy their first copy's rank afterwards.
+    let mut u = 0usize;
+    for p in 0..n {
+        rank[p] = 0;
+        fenwick[p] = 0;
+        if p == 0 || !equal_prev(p) {
+            work[u] = p as u32;
+            u += 1;
+        }
     }
-    let u = unique_positions(n, &equal_prev, rank, work);
     let mut ctx = Ctx {
         val: &val,
         rank: &mut rank[..n],
@@ -105,7 +111,7 @@ pub fn rank_sorted<V: Fn(usize, usize) -> f32>(
         order1: &order1[..n],
         fenwick: &mut fenwick[..n],
     };
-    ctx.helper_a::<false>(&mut work[..u], k);
+    ctx.helper_a(&mut work[..u], k);
     let mut fronts = 0u32;
     for p in 0..n {
         if p > 0 && equal_prev(p) {
@@ -114,69 +120,6 @@ pub fn rank_sorted<V: Fn(usize, usize) -> f32>(
         fronts = fronts.max(rank[p] + 1);
     }
     fronts as usize
-}
-
-/// The first front only: `dominated[p]` = 1 if position `p` is dominated, else 0; returns
-/// the number of non-dominated solutions. Same input order and workspaces as
-/// [`rank_sorted`] (`order1` and `fenwick` are not used), and the same recursion with a
-/// flag instead of a rank: the two-objective sweeps keep a running maximum instead of a
-/// Fenwick tree and dominated solutions are not checked again, so it costs a fraction of
-/// the full ranking. The swarm's selection needs no more when the first front holds at
-/// least the half it keeps (83 % of the groups with three or more objectives, measured).
-pub fn first_front_sorted<V: Fn(usize, usize) -> f32>(
-    n: usize,
-    k: usize,
-    val: V,
-    dominated: &mut [u32],
-    ws: Workspace<'_>,
-) -> usize {
-    let Workspace {
-        work,
-        scratch,
-        order1,
-        fenwick,
-    } = ws;
-    let n = n.min(dominated.len()).min(work.len()).min(scratch.len());
-    if n == 0 {
-        return 0;
-    }
-    let equal_prev = |p: usize| (0..k).all(|j| val(p, j) == val(p - 1, j));
-    let u = unique_positions(n, &equal_prev, dominated, work);
-    let mut ctx = Ctx {
-        val: &val,
-        rank: &mut dominated[..n],
-        scratch: &mut scratch[..n],
-        order1: &order1[..0],
-        fenwick: &mut fenwick[..0],
-    };
-    ctx.helper_a::<true>(&mut work[..u], k);
-    let mut free = 0usize;
-    for p in 0..n {
-        if p > 0 && equal_prev(p) {
-            dominated[p] = dominated[p - 1];
-        }
-        free += (dominated[p] == 0) as usize;
-    }
-    free
-}
-
-/// Zeroes `out[..n]` and lists the first position of each run of equal vectors in
-/// `work`; returns the number of unique vectors.
-fn unique_positions(
-    n: usize,
-    equal_prev: &impl Fn(usize) -> bool,
-    out: &mut [u32],
-    work: &mut [u32],
-) -> usize {
-    let mut u = 0usize;
-    for (p, o) in out[..n].iter_mut().enumerate() {
-        *o = 0;
-        if p == 0 || !equal_prev(p) {
-            work[u] = p as u32;
-            u += 1;
-        }
-    }
-    u
 }
 
 struct Ctx<'a, V> {
@@ -201,13 +144,8 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
         (0..k).all(|j| self.v(a, j) >= self.v(b, j))
     }
 
-    /// `h` is dominated by `from`: its rank rises above `from`'s (`MAX`: its flag is set).
     #[inline]
-    fn raise<const MAX: bool>(&mut self, h: u32, from: u32) {
-        if MAX {
-            self.rank[h as usize] = 1;
-            return;
-        }
+    fn raise(&mut self, h: u32, from: u32) {
         let r = self.rank[from as usize] + 1;
         let t = &mut self.rank[h as usize];
         if r > *t {
@@ -215,7 +153,7 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
         }
     }
 
-    fn helper_a<const MAX: bool>(&mut self, s: &mut [u32], k: usize) {
+    fn helper_a(&mut self, s: &mut [u32], k: usize) {
         let n = s.len();
         if n < 2 {
             return;
@@ -224,63 +162,57 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
             // Position order: every earlier solution's rank is final when used.
             for i in 1..n {
                 for j in 0..i {
-                    if MAX && self.rank[s[i] as usize] != 0 {
-                        break;
-                    }
                     if self.weakly(s[j], s[i], k) {
-                        self.raise::<MAX>(s[i], s[j]);
+                        self.raise(s[i], s[j]);
                     }
                 }
             }
             return;
         }
         if k == 2 {
-            self.sweep::<MAX>(s, s, true);
+            self.sweep(s, s, true);
             return;
         }
         let o = k - 1;
         let (mn, mx) = self.range(s, o);
         if mn == mx {
-            self.helper_a::<MAX>(s, k - 1);
+            self.helper_a(s, k - 1);
             return;
         }
         let (p, ge) = self.pivot(s, &[], o, mx);
         let nb = self.partition(s, o, p, ge);
         {
             let (b, w) = s.split_at_mut(nb);
-            self.helper_a::<MAX>(b, k);
-            self.helper_b::<MAX>(b, w, k - 1);
-            self.helper_a::<MAX>(w, k);
+            self.helper_a(b, k);
+            self.helper_b(b, w, k - 1);
+            self.helper_a(w, k);
         }
         self.merge(s, nb);
     }
 
-    fn helper_b<const MAX: bool>(&mut self, l: &mut [u32], h: &mut [u32], k: usize) {
+    fn helper_b(&mut self, l: &mut [u32], h: &mut [u32], k: usize) {
         if l.is_empty() || h.is_empty() {
             return;
         }
         if k <= 1 || l.len() * h.len() <= SMALL * SMALL {
             for &hh in h.iter() {
                 for &ll in l.iter() {
-                    if MAX && self.rank[hh as usize] != 0 {
-                        break;
-                    }
                     if self.weakly(ll, hh, k) {
-                        self.raise::<MAX>(hh, ll);
+                        self.raise(hh, ll);
                     }
                 }
             }
             return;
         }
         if k == 2 {
-            self.sweep::<MAX>(l, h, false);
+            self.sweep(l, h, false);
             return;
         }
         let o = k - 1;
         let (mnl, mxl) = self.range(l, o);
         let (mnh, mxh) = self.range(h, o);
         if mnl >= mxh {
-            self.helper_b::<MAX>(l, h, k - 1);
+            self.helper_b(l, h, k - 1);
             return;
         }
         if mxl < mnh {
@@ -292,9 +224,9 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
         {
             let (l1, l2) = l.split_at_mut(nl);
             let (h1, h2) = h.split_at_mut(nh);
-            self.helper_b::<MAX>(l1, h1, k);
-            self.helper_b::<MAX>(l1, h2, k - 1);
-            self.helper_b::<MAX>(l2, h2, k);
+            self.helper_b(l1, h1, k);
+            self.helper_b(l1, h2, k - 1);
+            self.helper_b(l2, h2, k);
         }
         self.merge(l, nl);
         self.merge(h, nh);
@@ -304,32 +236,7 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
     /// otherwise the ranks of `h` are raised from `l`. Walks in objective 0 (position
     /// order, `l` before `h` at ties) with a Fenwick tree of `rank + 1` indexed by the
     /// dense descending rank of objective 1, so `val1(t) >= val1(h)` is a prefix.
-    fn sweep<const MAX: bool>(&mut self, l: &[u32], h: &[u32], same: bool) {
-        if MAX {
-            // Dominated iff some solution before it in objective 0 has objective 1 `>=`.
-            let mut best = f32::NEG_INFINITY;
-            let mut next_l = 0usize;
-            for &hh in h {
-                if !same {
-                    let x0 = self.v(hh, 0);
-                    while next_l < l.len() && self.v(l[next_l], 0) >= x0 {
-                        let x1 = self.v(l[next_l], 1);
-                        if x1 > best {
-                            best = x1;
-                        }
-                        next_l += 1;
-                    }
-                }
-                let x1 = self.v(hh, 1);
-                if best >= x1 {
-                    self.rank[hh as usize] = 1;
-                }
-                if same && x1 > best {
-                    best = x1;
-                }
-            }
-            return;
-        }
+    fn sweep(&mut self, l: &[u32], h: &[u32], same: bool) {
         let mut next_l = 0usize;
         for &hh in h {
             if !same {

@@ -667,36 +667,12 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
         (taken, 0)
     }
 
-    /// Three or more active objectives: the first front by [`ndsort::first_front_sorted`];
-    /// if it holds fewer than `keep`, all ranks by [`ndsort::rank_sorted`] (position ranks
-    /// in `rank[s..e]`, workspaces `head`, `next`, `aux`, `crowd` over `s..e`); then as
+    /// Three or more active objectives: ranks by [`ndsort::rank_sorted`] (position
+    /// ranks in `rank[s..e]`, workspaces `head`, `next`, `aux`, `crowd` over `s..e`), then as
     /// [`Swarm::fronts_two`].
     fn fronts_many(&mut self, s: usize, e: usize, keep: usize, act: &[usize]) -> (usize, usize) {
         let len = e - s;
         let (fit, order) = (&self.fit, &self.order);
-        // The first front first: when it holds at least `keep`, it is the cut front.
-        let free = ndsort::first_front_sorted(
-            len,
-            act.len(),
-            |p, j| fit[order[s + p] as usize][act[j]],
-            &mut self.rank[s..e],
-            ndsort::Workspace {
-                work: &mut self.head[s..e],
-                scratch: &mut self.next[s..e],
-                order1: &mut self.aux[s..e],
-                fenwick: &mut self.crowd[s..e],
-            },
-        );
-        if free >= keep {
-            let mut c = 0usize;
-            for p in 0..len {
-                if self.rank[s + p] == 0 {
-                    self.head[s + c] = self.order[s + p];
-                    c += 1;
-                }
-            }
-            return (0, c);
-        }
         let fronts = ndsort::rank_sorted(
             len,
             act.len(),
