@@ -5,8 +5,9 @@
 //!
 //! `cargo run --release --example phd_frame_times [VARIANT [force]]` (VARIANT: `phd`,
 //! `kmeans`, `dbscan`, `all`; default all three; `force`: the swarm's stop threshold is
-//! set above the largest fitness, so every frame with a swarm runs all `gen = 10`
-//! generations: the swarm's worst case). CPU time is the thread's, so time spent waiting for a
+//! set above the largest fitness, so every frame with a swarm runs `max_generations`
+//! (20) generations instead of `gen = 10` and stopping: the swarm's worst case). `FAINT_RUNS=1` measures the first run only (for
+//! instruction profiles under callgrind). CPU time is the thread's, so time spent waiting for a
 //! core on a loaded machine is not counted (Linux x86_64 / aarch64 only).
 use faint_core::rng::Rng;
 use faint_host::scenario::six_targets::{HostFilter, SixTargets, Variant};
