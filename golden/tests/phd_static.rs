@@ -115,6 +115,17 @@ fn reconfigure_equals_new() {
 /// or doubled one of the three targets would exceed 0.5.
 #[test]
 fn firmware_configuration_tracks_the_scene() {
+    // `Firmware::new` builds the ~0.9 MB filter by value before it is boxed: a thread
+    // with a big stack (the test harness gives 2 MiB).
+    std::thread::Builder::new()
+        .stack_size(64 << 20)
+        .spawn(firmware_configuration_tracks_the_scene_body)
+        .unwrap()
+        .join()
+        .unwrap();
+}
+
+fn firmware_configuration_tracks_the_scene_body() {
     let mut states = [[0.0f32; 4]; 3];
     for v in Variant::ALL {
         let mut err = 0usize;
