@@ -292,6 +292,43 @@ impl ExistenceDraw {
     }
 }
 
+/// The births of eq. 9 among absent particles, drawn by geometric skipping: in one pass
+/// over the particles every `E_{k-1} = 0` particle is born independently with
+/// probability `Pb`, so the number of absent particles that stay absent before the next
+/// birth is geometric, `P(G >= g) = (1 - Pb)^g`. [`gap`](Self::gap) draws it by
+/// inversion, `G = floor(ln U / ln(1 - Pb))` with `U` uniform on `(0, 1]` (24 bits), so
+/// one draw and one `ln` per birth replace one draw per absent particle. The same law
+/// as a draw per particle (up to the 2^-24 resolution of `U`, which also bounds `G` by
+/// `16.7 / -ln(1 - Pb)`, e.g. 324 for `Pb = 0.05`: `P(G > 324) < 6e-8`).
+#[derive(Debug, Clone, Copy)]
+struct Births {
+    /// `1 / ln(1 - Pb)` (`<= 0`; `-0` when `Pb = 1`).
+    scale: f32,
+    /// `Pb = 0`: no absent particle is ever born.
+    never: bool,
+}
+
+impl Births {
+    fn new(chain: &crate::existence::ExistenceMarkov) -> Self {
+        let pb = chain.birth();
+        Self {
+            scale: 1.0 / math::ln1p(-pb),
+            never: pb <= 0.0,
+        }
+    }
+
+    /// Absent particles that stay absent before the next birth.
+    #[inline(never)]
+    fn gap(&self, mut rng: Rng) -> (Rng, u32) {
+        if self.never {
+            return (rng, u32::MAX);
+        }
+        // ln U <= 0 and scale <= 0: a non-negative product (saturating conversion).
+        let g = (math::ln(rng.uniform_open0()) * self.scale) as u32;
+        (rng, g)
+    }
+}
+
 /// `ln(e^a + e^b)`, exact for `-inf` arguments.
 #[inline]
 fn log_add_exp(a: f32, b: f32) -> f32 {
@@ -364,9 +401,83 @@ struct UpdateCtx<'a> {
     r_th2: f32,
     ln_free: bool,
     ln_lambda: f32,
+    zz_floor: f32,
+    draw: &'a ExistenceDraw,
+    births: Births,
+}
+
+/// What the update loop accumulates out of line.
+struct UpdateState<'a> {
+    rng: Rng,
+    /// Present particles so far; their indices are in `anc[..count]`.
+    count: usize,
+    /// Smallest cost of a present particle and its index.
+    best: f32,
+    arg: Option<usize>,
+    anc: &'a mut [u32],
 }
 
 impl UpdateCtx<'_> {
+    /// An absent particle that stays absent when `lambda > 0`: `E = 0`, `x = 0`, `h = 0`,
+    /// `C = lambda Cbar + ||z||^p`.
+    #[cold]
+    #[inline(never)]
+    fn absent(&self, slot: &mut Particle) {
+        *slot = Particle {
+            x: [0.0; 3],
+            log_c: log_cost(self.cfg, self.zz_floor, slot.log_c, self.ln_lambda),
+            zh: Complex32::new(0.0, 0.0),
+            hh: 0.0,
+        };
+    }
+
+    /// Step (4) for particle `i` when it is present at `k - 1` (`*flag`), or absent with
+    /// its birth gap run out (`left = 0`): the existence draw, then
+    /// [`update_present`](Self::update_present) or [`absent`](Self::absent). Returns the
+    /// new gap.
+    #[inline(never)]
+    fn other(
+        &self,
+        st: &mut UpdateState<'_>,
+        flag: &mut bool,
+        slot: &mut Particle,
+        i: usize,
+        mut left: u32,
+    ) -> u32 {
+        let e = *flag;
+        let mut rng = st.rng.clone();
+        let present = if e {
+            self.draw.next(true, &mut rng)
+        } else {
+            let (r, g) = self.births.gap(rng);
+            rng = r;
+            left = g;
+            true
+        };
+        if present {
+            let (r, log_c) = self.update_present(slot, e, rng);
+            rng = r;
+            if let Some(log_c) = log_c {
+                st.rng = rng;
+                *flag = true;
+                st.count += 1;
+                if let Some(s) = st.anc.get_mut(st.count - 1) {
+                    *s = i as u32;
+                }
+                if log_c < st.best {
+                    st.best = log_c;
+                    st.arg = Some(i);
+                }
+                return left;
+            }
+        }
+        st.rng = rng;
+        *flag = false;
+        if self.cfg.lambda > 0.0 {
+            self.absent(slot);
+        }
+        left
+    }
     /// Step (4) for a particle with `E_k = 1`: jitter `x ~ N(F xbar, Sigma)` if it
     /// continues (`existed`), a birth from `U(I_x0)` otherwise, then the gate (eq. 10)
     /// and the cost. On a pass writes the new state into `slot` and returns its cost;
@@ -474,33 +585,92 @@ fn risk_pass(
     // indexed load per particle, instead of being held in two (spilled) registers and
     // selected.
     let draw = core::hint::black_box(&draw_table);
-    let mut rng = rng_out.clone();
-    let mut dmin = f32::INFINITY;
-    // Present particles are counted (not absent ones), and the three arrays are zipped
-    // (no index, no bounds check), so the loop over mostly absent particles keeps
-    // everything in registers.
-    let mut n_present = 0usize;
+    let births = Births::new(&model.chain);
+    let (rng, mut left) = births.gap(rng_out.clone());
+    let ctx = RiskCtx {
+        model,
+        z,
+        zz,
+        zz_floor,
+        draw,
+        births,
+    };
+    let mut st = RiskState {
+        rng,
+        dmin: f32::INFINITY,
+        n_present: 0,
+    };
     let n = exists.len().min(out.len()).min(parts.len());
+    // The loop itself handles only the common case, an absent particle that stays absent
+    // (geometric skipping: one decrement, no draw); everything else is out of line with
+    // the generator in memory, so the loop keeps three pointers, the counters and
+    // `||z||^2` in registers.
     for ((&e, o), p) in exists.iter().zip(out.iter_mut()).zip(parts.iter()) {
-        if draw.next(e, &mut rng) {
-            let (r, d2) = risk_present(model, z, zz, &p.x, e, rng);
-            rng = r;
-            *o = d2;
-            n_present += 1;
-            // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never
-            // NaN.
-            if d2 < dmin {
-                dmin = d2;
-            }
-        } else {
+        if !e && left > 0 {
+            left -= 1;
             *o = zz_floor;
+            continue;
         }
+        let (l, v) = ctx.other(&mut st, e, &p.x, left);
+        left = l;
+        *o = v;
     }
-    if n_present < n && zz_floor < dmin {
+    let mut dmin = st.dmin;
+    if st.n_present < n && zz_floor < dmin {
         dmin = zz_floor;
     }
-    *rng_out = rng;
+    *rng_out = st.rng;
     dmin
+}
+
+/// What the risk pass needs for a particle that is present at `k - 1` or is born.
+struct RiskCtx<'a> {
+    model: &'a Model,
+    z: &'a [Complex32],
+    zz: f32,
+    zz_floor: f32,
+    draw: &'a ExistenceDraw,
+    births: Births,
+}
+
+/// What the risk pass accumulates out of line.
+struct RiskState {
+    rng: Rng,
+    dmin: f32,
+    n_present: usize,
+}
+
+impl RiskCtx<'_> {
+    /// A particle present at `k - 1` (`e`), or an absent one whose birth gap ran out
+    /// (`left = 0`): its predicted existence, its residual (`||z||^2` floored if absent)
+    /// and the new gap.
+    #[inline(never)]
+    fn other(&self, st: &mut RiskState, e: bool, x: &[f32; 3], mut left: u32) -> (u32, f32) {
+        let mut rng = st.rng.clone();
+        let present = if e {
+            self.draw.next(true, &mut rng)
+        } else {
+            let (r, g) = self.births.gap(rng);
+            rng = r;
+            left = g;
+            true
+        };
+        let v = if present {
+            let (r, d2) = risk_present(self.model, self.z, self.zz, x, e, rng);
+            rng = r;
+            st.n_present += 1;
+            // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never
+            // NaN.
+            if d2 < st.dmin {
+                st.dmin = d2;
+            }
+            d2
+        } else {
+            self.zz_floor
+        };
+        st.rng = rng;
+        (left, v)
+    }
 }
 
 /// CRPF-TBD with `N` particles.
@@ -711,64 +881,54 @@ impl<const N: usize> CrpfTbd<N> {
 
         // Step (4): update existence, jitter / births, gate, costs.
         let zz_floor = zz.max(f32::MIN_POSITIVE);
+        let draw_table = ExistenceDraw::new(&self.model.chain);
         let ctx = UpdateCtx {
             model: &self.model,
             cfg: &self.cfg,
             z,
             zz,
+            zz_floor,
             norm_m2: zz + self.prev_zz,
             r_th2: self.cfg.r_th * self.cfg.r_th,
             ln_free: self.int_exponent.is_some(),
             ln_lambda,
+            draw: &draw_table,
+            births: Births::new(&self.model.chain),
         };
         // `anc` (free after resampling) collects the indices of the E = 1 particles, so
-        // the estimates visit only those; the min-cost one is tracked here.
-        let mut count = 0usize;
-        let mut best = f32::INFINITY;
-        let mut arg = None;
-        let mut rng = self.rng.clone();
-        let draw_table = ExistenceDraw::new(&self.model.chain);
-        // Opaque reference: one indexed load per particle (see `risk_pass`).
-        let draw = core::hint::black_box(&draw_table);
+        // the estimates visit only those; the min-cost one is tracked too.
+        let births = Births::new(&self.model.chain);
+        let (rng, mut left) = births.gap(self.rng.clone());
+        let mut st = UpdateState {
+            rng,
+            count: 0,
+            best: f32::INFINITY,
+            arg: None,
+            anc: &mut self.anc,
+        };
         // With lambda = 0 an absent particle's state is never read again: only its flag
-        // is written.
+        // is written (and it is already `false`).
         let keep_absent = self.cfg.lambda > 0.0;
-        // Flags and states zipped: no index bounds check in the loop.
+        // Flags and states zipped: no index bounds check in the loop. As in `risk_pass`,
+        // the loop handles only an absent particle that stays absent; the rest is out of
+        // line.
         for (i, (flag, slot)) in self
             .exists
             .iter_mut()
             .zip(self.parts.iter_mut())
             .enumerate()
         {
-            let e = *flag;
-            if draw.next(e, &mut rng) {
-                let (r, log_c) = ctx.update_present(slot, e, rng);
-                rng = r;
-                if let Some(log_c) = log_c {
-                    *flag = true;
-                    count += 1;
-                    if let Some(s) = self.anc.get_mut(count - 1) {
-                        *s = i as u32;
-                    }
-                    if log_c < best {
-                        best = log_c;
-                        arg = Some(i);
-                    }
-                    continue;
+            if !*flag && left > 0 {
+                left -= 1;
+                if keep_absent {
+                    ctx.absent(slot);
                 }
+                continue;
             }
-            *flag = false;
-            if keep_absent {
-                // E = 0: x = 0, h = 0, C = lambda Cbar + ||z||^p.
-                *slot = Particle {
-                    x: [0.0; 3],
-                    log_c: log_cost(&self.cfg, zz_floor, slot.log_c, ln_lambda),
-                    zh: Complex32::new(0.0, 0.0),
-                    hh: 0.0,
-                };
-            }
+            left = ctx.other(&mut st, flag, slot, i, left);
         }
-        self.rng = rng;
+        let (count, best, arg) = (st.count, st.best, st.arg);
+        self.rng = st.rng;
 
         let (mean, min) = self.estimates(count, best, arg);
         self.prev[..m].copy_from_slice(z);
@@ -851,6 +1011,49 @@ impl<const N: usize> FrameDetector for CrpfTbd<N> {
 mod tests {
     use super::*;
     use std::vec::Vec;
+
+    #[test]
+    fn birth_gaps_are_geometric() {
+        // Births by geometric skipping against the law of one Bernoulli(Pb) draw per
+        // absent particle: over 400 000 absent particles the birth rate and the law of
+        // the gap (P(G = 0) = Pb, P(G >= 20) = (1 - Pb)^20) must match within 5 binomial
+        // standard deviations (sd of the rate 3.4e-4 at Pb = 0.05), i.e. an error of
+        // 1.7e-3 in the rate fails.
+        for pb in [0.05f32, 0.3] {
+            let chain = crate::existence::ExistenceMarkov::new(pb, 0.05).unwrap();
+            let b = Births::new(&chain);
+            let mut rng = Rng::seed_from_u64(3);
+            let (mut births, mut absent) = (0u64, 0u64);
+            let (mut zero, mut long, mut gaps) = (0u64, 0u64, 0u64);
+            while absent < 400_000 {
+                let (r, g) = b.gap(rng);
+                rng = r;
+                gaps += 1;
+                zero += (g == 0) as u64;
+                long += (g >= 20) as u64;
+                absent += g as u64 + 1;
+                births += 1;
+            }
+            let p = pb as f64;
+            let check = |got: f64, want: f64, n: u64| {
+                let sd = (want * (1.0 - want) / n as f64).sqrt();
+                assert!((got - want).abs() < 5.0 * sd, "pb {pb}: {got} vs {want}");
+            };
+            check(births as f64 / absent as f64, p, absent);
+            check(zero as f64 / gaps as f64, p, gaps);
+            check(long as f64 / gaps as f64, (1.0 - p).powi(20), gaps);
+        }
+        // Pb = 0: never born; Pb = 1: always born.
+        let never = Births::new(&crate::existence::ExistenceMarkov::new(0.0, 0.05).unwrap());
+        assert_eq!(never.gap(Rng::seed_from_u64(1)).1, u32::MAX);
+        let always = Births::new(&crate::existence::ExistenceMarkov::new(1.0, 0.05).unwrap());
+        let mut rng = Rng::seed_from_u64(1);
+        for _ in 0..1000 {
+            let (r, g) = always.gap(rng);
+            rng = r;
+            assert_eq!(g, 0);
+        }
+    }
 
     #[test]
     fn fused_systematic_equals_resample() {
