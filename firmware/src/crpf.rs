@@ -40,72 +40,62 @@ fn measure_one(name: &str, n: u32, det: &mut dyn FrameDetector, model: &DopplerM
     row(name, n, "particle", m, ram);
 }
 
-/// CRPF-TBD over `SEEDS` detector seeds: the sum of the measured frame-7 steps (the same
-/// frames as [`measure_one`]), printed as one row whose unit is a particle-frame, so its
-/// per-unit column is the mean over seeds. The instructions of a step grow with the
-/// fraction of present particles, which is random (about 310 per present particle, 161 per
-/// absent one at `65b3037`), so a single seed's count says more about that seed's lock-on
-/// than about the code; the line after the row prints the mean existence of the measured
-/// frame. Also measures frame 2 (no target yet, almost every particle absent: the floor).
+/// CRPF-TBD over `SEEDS` detector seeds on the frames of [`measure_one`] (target present
+/// in frames 3..=8, 0-based). The instructions of a step grow with the fraction of
+/// present particles, which is random, so one seed's count says as much about that
+/// seed's lock-on as about the code. Three rows, each the sum over seeds (unit: one
+/// particle-frame, so the per-unit column is the mean): frame 1 (no target, almost every
+/// particle absent: the floor), frame 6 (the frame of the single-seed row) and frame 8
+/// (the sixth frame with the target, mostly locked on); each followed by the mean
+/// existence after that frame.
 fn crpf_rows<const N: usize>(crpf: &mut CrpfTbd<N>, model: &DopplerModel) {
-    const SEEDS: u64 = 8;
-    let mut total = 0u64;
+    const SEEDS: u64 = 32;
+    const FRAMES: [usize; 3] = [1, 6, 8];
+    let mut total = [0u64; 3];
     let mut stack = 0u32;
-    let mut present = 0u64;
-    let mut floor = 0u64;
+    let mut present = [0u64; 3];
     for s in 0..SEEDS {
         check(crpf.reconfigure(CrpfConfig::othr(), SEED + s));
         let mut rng = Rng::from_stream(SEED, 1);
         let mut z = [Complex32::new(0.0, 0.0); 32];
-        for k in 0..6 {
+        for k in 0..=8 {
             let (fd, amp) = target(k);
             frame(model, fd, amp, BIN_VAR, &mut rng, &mut z);
-            if k == 1 {
-                let (r, m) = measure(|| crpf.step(black_box(&z)));
-                check(r);
-                floor += m.instructions;
-            } else {
-                check(crpf.step(&z));
+            match FRAMES.iter().position(|&f| f == k) {
+                Some(j) => {
+                    let (r, m) = measure(|| crpf.step(black_box(&z)));
+                    let rep = check(r);
+                    total[j] += m.instructions;
+                    stack = stack.max(m.stack_bytes);
+                    present[j] += (rep.existence * N as f32 + 0.5) as u64;
+                }
+                None => {
+                    check(crpf.step(&z));
+                }
             }
         }
-        let (fd, amp) = target(6);
-        frame(model, fd, amp, BIN_VAR, &mut rng, &mut z);
-        let (r, m) = measure(|| crpf.step(black_box(&z)));
-        let rep = check(r);
-        total += m.instructions;
-        stack = stack.max(m.stack_bytes);
-        present += (rep.existence * N as f32 + 0.5) as u64;
     }
     let units = (N as u64 * SEEDS) as u32;
     let ram = size_of::<CrpfTbd<N>>();
-    let mean = Measurement {
-        instructions: total,
-        stack_bytes: stack,
-    };
-    row(
-        "CRPF-TBD step, mean of 8 seeds",
-        units,
-        "particle",
-        mean,
-        ram,
-    );
-    let floor = Measurement {
-        instructions: floor,
-        stack_bytes: stack,
-    };
-    row(
-        "CRPF-TBD step, frame 2, 8 seeds",
-        units,
-        "particle",
-        floor,
-        ram,
-    );
-    hprintln!(
-        "crpf N = {}: mean existence after the measured frame over 8 seeds = {} / {}",
-        N,
-        present,
-        N as u64 * SEEDS
-    );
+    let names = [
+        "CRPF-TBD frame 1 (no target), 32 seeds",
+        "CRPF-TBD frame 6, 32 seeds",
+        "CRPF-TBD frame 8 (locked), 32 seeds",
+    ];
+    for j in 0..3 {
+        let m = Measurement {
+            instructions: total[j],
+            stack_bytes: stack,
+        };
+        row(names[j], units, "particle", m, ram);
+        hprintln!(
+            "crpf N = {}: mean existence after frame {} over 32 seeds = {} / {}",
+            N,
+            FRAMES[j],
+            present[j],
+            N as u64 * SEEDS
+        );
+    }
 }
 
 /// An all-zero `static` detector. The initialiser is const-evaluated, and the const

@@ -295,37 +295,86 @@ impl ExistenceDraw {
 /// The births of eq. 9 among absent particles, drawn by geometric skipping: in one pass
 /// over the particles every `E_{k-1} = 0` particle is born independently with
 /// probability `Pb`, so the number of absent particles that stay absent before the next
-/// birth is geometric, `P(G >= g) = (1 - Pb)^g`. [`gap`](Self::gap) draws it by
-/// inversion, `G = floor(ln U / ln(1 - Pb))` with `U` uniform on `(0, 1]` (24 bits), so
-/// one draw and one `ln` per birth replace one draw per absent particle. The same law
-/// as a draw per particle (up to the 2^-24 resolution of `U`, which also bounds `G` by
-/// `16.7 / -ln(1 - Pb)`, e.g. 324 for `Pb = 0.05`: `P(G > 324) < 6e-8`).
+/// birth is geometric, `P(G >= g) = (1 - Pb)^g`, and one draw of `G` per birth replaces
+/// one draw per absent particle. [`gap`](Self::gap) draws `G` by inversion of its
+/// distribution function on one `u32`: `G = g` for `T_{g-1} <= u < T_g`,
+/// `T_g = 2^32 (1 - (1 - Pb)^(g+1))` (a table of 32 entries, binary search); a draw
+/// beyond the table (probability `(1 - Pb)^32`, 0.19 for `Pb = 0.05`) adds 32 and draws
+/// again, which is exact because the geometric law is memoryless. When `(1 - Pb)^32 > 1/2`
+/// (`Pb` below about 0.021) the table would loop too often, and
+/// `G = floor(ln U / ln(1 - Pb))` (`U` uniform on `(0, 1]`, 24 bits) is used instead. The
+/// same law as one draw per particle, up to the rounding of `T_g` (`f32`, relative
+/// error below `1e-5`) or the 2^-24 resolution of `U`.
 #[derive(Debug, Clone, Copy)]
 struct Births {
-    /// `1 / ln(1 - Pb)` (`<= 0`; `-0` when `Pb = 1`).
+    /// `T_g`, `g = 0..32`.
+    thr: [u32; 32],
+    /// `1 / ln(1 - Pb)` for the logarithmic fallback.
     scale: f32,
+    mode: BirthMode,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum BirthMode {
     /// `Pb = 0`: no absent particle is ever born.
-    never: bool,
+    Never,
+    /// `Pb = 1`: every absent particle is born.
+    Always,
+    Table,
+    Log,
 }
 
 impl Births {
     fn new(chain: &crate::existence::ExistenceMarkov) -> Self {
         let pb = chain.birth();
+        let q = 1.0 - pb;
+        let mut thr = [0u32; 32];
+        let mut tail = 1.0f32;
+        for t in thr.iter_mut() {
+            tail *= q;
+            // P(G <= g) 2^32, saturating at u32::MAX.
+            *t = ((1.0 - tail) * 4_294_967_296.0) as u32;
+        }
+        let mode = if pb <= 0.0 {
+            BirthMode::Never
+        } else if pb >= 1.0 {
+            BirthMode::Always
+        } else if tail > 0.5 {
+            BirthMode::Log
+        } else {
+            BirthMode::Table
+        };
         Self {
+            thr,
             scale: 1.0 / math::ln1p(-pb),
-            never: pb <= 0.0,
+            mode,
         }
     }
 
     /// Absent particles that stay absent before the next birth.
     #[inline(never)]
     fn gap(&self, mut rng: Rng) -> (Rng, u32) {
-        if self.never {
-            return (rng, u32::MAX);
+        match self.mode {
+            BirthMode::Table => {
+                let last = self.thr[31];
+                let mut base = 0u32;
+                loop {
+                    let u = rng.next_u32();
+                    if u < last {
+                        let g = self.thr.partition_point(|&t| t <= u) as u32;
+                        return (rng, base.saturating_add(g));
+                    }
+                    base = base.saturating_add(32);
+                }
+            }
+            BirthMode::Log => {
+                // ln U <= 0 and scale < 0: a non-negative product (saturating conversion).
+                let g = (math::ln(rng.uniform_open0()) * self.scale) as u32;
+                (rng, g)
+            }
+            BirthMode::Never => (rng, u32::MAX),
+            BirthMode::Always => (rng, 0),
         }
-        // ln U <= 0 and scale <= 0: a non-negative product (saturating conversion).
-        let g = (math::ln(rng.uniform_open0()) * self.scale) as u32;
-        (rng, g)
     }
 }
 
@@ -403,7 +452,31 @@ struct UpdateCtx<'a> {
     ln_lambda: f32,
     zz_floor: f32,
     draw: &'a ExistenceDraw,
-    births: Births,
+    births: &'a Births,
+}
+
+/// Step (4) over all particles, from birth gap `left`. Flags and states zipped: no index
+/// bounds check. As in `risk_pass`, the loop handles only an absent particle that stays
+/// absent; the rest is out of line. `KEEP` (`lambda > 0`, a constant so that the loop
+/// tests no flag): absent particles get their state written.
+#[inline(always)]
+fn update_loop<const KEEP: bool>(
+    ctx: &UpdateCtx<'_>,
+    st: &mut UpdateState<'_>,
+    exists: &mut [bool],
+    parts: &mut [Particle],
+    mut left: u32,
+) {
+    for (i, (flag, slot)) in exists.iter_mut().zip(parts.iter_mut()).enumerate() {
+        if !*flag && left > 0 {
+            left -= 1;
+            if KEEP {
+                ctx.absent(slot);
+            }
+            continue;
+        }
+        left = ctx.other(st, flag, slot, i, left);
+    }
 }
 
 /// What the update loop accumulates out of line.
@@ -570,6 +643,7 @@ fn risk_present(
 /// Its own function so that the loop over mostly absent particles keeps the generator
 /// and its pointers in registers.
 #[inline(never)]
+#[allow(clippy::too_many_arguments)]
 fn risk_pass(
     model: &Model,
     z: &[Complex32],
@@ -578,6 +652,7 @@ fn risk_pass(
     parts: &[Particle],
     out: &mut [f32],
     rng_out: &mut Rng,
+    births: &Births,
 ) -> f32 {
     let zz_floor = zz.max(f32::MIN_POSITIVE);
     let draw_table = ExistenceDraw::new(&model.chain);
@@ -585,7 +660,6 @@ fn risk_pass(
     // indexed load per particle, instead of being held in two (spilled) registers and
     // selected.
     let draw = core::hint::black_box(&draw_table);
-    let births = Births::new(&model.chain);
     let (rng, mut left) = births.gap(rng_out.clone());
     let ctx = RiskCtx {
         model,
@@ -630,7 +704,7 @@ struct RiskCtx<'a> {
     zz: f32,
     zz_floor: f32,
     draw: &'a ExistenceDraw,
-    births: Births,
+    births: &'a Births,
 }
 
 /// What the risk pass accumulates out of line.
@@ -691,6 +765,8 @@ pub struct CrpfTbd<const N: usize> {
     frame: u32,
     /// `q p / 2` when the ln-free weight path applies.
     int_exponent: Option<u32>,
+    /// The birth-gap sampler of the model's existence chain.
+    births: Births,
 }
 
 impl<const N: usize> CrpfTbd<N> {
@@ -704,6 +780,7 @@ impl<const N: usize> CrpfTbd<N> {
         }
         let model = cfg.validate()?;
         let int_exponent = int_exponent(&cfg);
+        let births = Births::new(&model.chain);
         let mut s = Self {
             cfg,
             model,
@@ -717,6 +794,7 @@ impl<const N: usize> CrpfTbd<N> {
             rng: Rng::seed_from_u64(seed),
             frame: 0,
             int_exponent,
+            births,
         };
         s.reset(seed);
         Ok(s)
@@ -734,6 +812,7 @@ impl<const N: usize> CrpfTbd<N> {
         }
         let model = cfg.validate()?;
         self.int_exponent = int_exponent(&cfg);
+        self.births = Births::new(&model.chain);
         self.cfg = cfg;
         self.model = model;
         self.reset(seed);
@@ -784,6 +863,7 @@ impl<const N: usize> CrpfTbd<N> {
             &self.parts,
             &mut self.log_w,
             &mut self.rng,
+            &self.births,
         );
         if let Some(n) = self.int_exponent {
             // w_i = (min d2 / d2_i)^(q p / 2): eq. 4 normalised by its largest weight,
@@ -893,12 +973,11 @@ impl<const N: usize> CrpfTbd<N> {
             ln_free: self.int_exponent.is_some(),
             ln_lambda,
             draw: &draw_table,
-            births: Births::new(&self.model.chain),
+            births: &self.births,
         };
         // `anc` (free after resampling) collects the indices of the E = 1 particles, so
         // the estimates visit only those; the min-cost one is tracked too.
-        let births = Births::new(&self.model.chain);
-        let (rng, mut left) = births.gap(self.rng.clone());
+        let (rng, left) = ctx.births.gap(self.rng.clone());
         let mut st = UpdateState {
             rng,
             count: 0,
@@ -908,24 +987,10 @@ impl<const N: usize> CrpfTbd<N> {
         };
         // With lambda = 0 an absent particle's state is never read again: only its flag
         // is written (and it is already `false`).
-        let keep_absent = self.cfg.lambda > 0.0;
-        // Flags and states zipped: no index bounds check in the loop. As in `risk_pass`,
-        // the loop handles only an absent particle that stays absent; the rest is out of
-        // line.
-        for (i, (flag, slot)) in self
-            .exists
-            .iter_mut()
-            .zip(self.parts.iter_mut())
-            .enumerate()
-        {
-            if !*flag && left > 0 {
-                left -= 1;
-                if keep_absent {
-                    ctx.absent(slot);
-                }
-                continue;
-            }
-            left = ctx.other(&mut st, flag, slot, i, left);
+        if self.cfg.lambda > 0.0 {
+            update_loop::<true>(&ctx, &mut st, &mut self.exists, &mut self.parts, left);
+        } else {
+            update_loop::<false>(&ctx, &mut st, &mut self.exists, &mut self.parts, left);
         }
         let (count, best, arg) = (st.count, st.best, st.arg);
         self.rng = st.rng;
@@ -1019,7 +1084,8 @@ mod tests {
         // the gap (P(G = 0) = Pb, P(G >= 20) = (1 - Pb)^20) must match within 5 binomial
         // standard deviations (sd of the rate 3.4e-4 at Pb = 0.05), i.e. an error of
         // 1.7e-3 in the rate fails.
-        for pb in [0.05f32, 0.3] {
+        // 0.01 takes the logarithmic path, 0.05 and 0.3 the table.
+        for pb in [0.01f32, 0.05, 0.3] {
             let chain = crate::existence::ExistenceMarkov::new(pb, 0.05).unwrap();
             let b = Births::new(&chain);
             let mut rng = Rng::seed_from_u64(3);
