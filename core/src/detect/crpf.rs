@@ -554,9 +554,9 @@ impl UpdateCtx<'_> {
     /// Step (4) for a particle with `E_k = 1`: jitter `x ~ N(F xbar, Sigma)` if it
     /// continues (`existed`), a birth from `U(I_x0)` otherwise, then the gate (eq. 10)
     /// and the cost. On a pass writes the new state into `slot` and returns its cost;
-    /// on a rejection leaves `slot` untouched. Out of line, with the generator by value,
-    /// so that the loop over mostly absent particles keeps its state in registers.
-    #[inline(never)]
+    /// on a rejection leaves `slot` untouched. Inlined into the out-of-line
+    /// [`other`](Self::other) (one call layer per present particle, not two).
+    #[inline(always)]
     fn update_present(
         &self,
         slot: &mut Particle,
@@ -618,9 +618,9 @@ impl UpdateCtx<'_> {
 }
 
 /// Step (2) for a particle with `E_k = 1` in the prediction: `||z - h(x)||^2` of `F x`
-/// (`existed`) or of a birth from `U(I_x0)`. Out of line, generator by value (see
-/// [`UpdateCtx::update_present`]).
-#[inline(never)]
+/// (`existed`) or of a birth from `U(I_x0)`. Inlined into the out-of-line
+/// [`RiskCtx::other`].
+#[inline(always)]
 fn risk_present(
     model: &Model,
     z: &[Complex32],
