@@ -7,6 +7,9 @@
 //! zero is a valid value of every field, see `zeroed!`) set up in place by
 //! `reconfigure`, so nothing of size `N` is built on the stack. The static-RAM column is
 //! their `size_of`.
+//!
+//! CRPF-TBD also gets three rows over 32 detector seeds (frames 1, 6 and 8, see
+//! `crpf_rows`), because its cost depends on the random fraction of present particles.
 
 use core::hint::black_box;
 use core::mem::{size_of, MaybeUninit};

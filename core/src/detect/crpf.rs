@@ -23,6 +23,10 @@
 //! births from `U(I_x0)`, apply the gate; (5) `P_E^k`.
 //!
 //! Implementation notes:
+//! - The existence draws of eq. 9 for `E_{k-1} = 0` particles are made by geometric
+//!   skipping (`Births`): in each pass the number of absent particles before the next
+//!   birth is drawn once (exactly geometric with parameter `Pb`), so an absent particle
+//!   that stays absent costs no draw. Present particles draw their death as before.
 //! - All weights are computed in the log domain: `ln mu_i = -q ln R_i` (eq. 4) with
 //!   `ln R_i = (p/2) ln ||.||^2` (or `logaddexp(ln lambda + ln Cbar, ...)`), then the
 //!   maximum is subtracted before `exp`, so nothing overflows `f32` even with `p = 8`.
