@@ -7,6 +7,9 @@
 //! zero is a valid value of every field, see `zeroed!`) set up in place by
 //! `reconfigure`, so nothing of size `N` is built on the stack. The static-RAM column is
 //! their `size_of`.
+//!
+//! CRPF-TBD also gets three rows over 32 detector seeds (frames 1, 6 and 8, see
+//! `crpf_rows`), because its cost depends on the random fraction of present particles.
 
 use core::hint::black_box;
 use core::mem::{size_of, MaybeUninit};
@@ -20,7 +23,8 @@ use faint_core::rng::Rng;
 use faint_core::Complex32;
 use faint_golden::crpf::{frame, target, BIN_VAR};
 
-use crate::harness::{check, measure, row};
+use crate::harness::{check, measure, row, Measurement};
+use cortex_m_semihosting::hprintln;
 
 const SEED: u64 = 0x00C0_57F1_17E2_2017;
 
@@ -37,6 +41,64 @@ fn measure_one(name: &str, n: u32, det: &mut dyn FrameDetector, model: &DopplerM
     let (r, m) = measure(|| det.step(black_box(&z)));
     check(r);
     row(name, n, "particle", m, ram);
+}
+
+/// CRPF-TBD over `SEEDS` detector seeds on the frames of [`measure_one`] (target present
+/// in frames 3..=8, 0-based). The instructions of a step grow with the fraction of
+/// present particles, which is random, so one seed's count says as much about that
+/// seed's lock-on as about the code. Three rows, each the sum over seeds (unit: one
+/// particle-frame, so the per-unit column is the mean): frame 1 (no target, almost every
+/// particle absent: the floor), frame 6 (the frame of the single-seed row) and frame 8
+/// (the sixth frame with the target, mostly locked on); each followed by the mean
+/// existence after that frame.
+fn crpf_rows<const N: usize>(crpf: &mut CrpfTbd<N>, model: &DopplerModel) {
+    const SEEDS: u64 = 32;
+    const FRAMES: [usize; 3] = [1, 6, 8];
+    let mut total = [0u64; 3];
+    let mut stack = 0u32;
+    let mut present = [0u64; 3];
+    for s in 0..SEEDS {
+        check(crpf.reconfigure(CrpfConfig::othr(), SEED + s));
+        let mut rng = Rng::from_stream(SEED, 1);
+        let mut z = [Complex32::new(0.0, 0.0); 32];
+        for k in 0..=8 {
+            let (fd, amp) = target(k);
+            frame(model, fd, amp, BIN_VAR, &mut rng, &mut z);
+            match FRAMES.iter().position(|&f| f == k) {
+                Some(j) => {
+                    let (r, m) = measure(|| crpf.step(black_box(&z)));
+                    let rep = check(r);
+                    total[j] += m.instructions;
+                    stack = stack.max(m.stack_bytes);
+                    present[j] += (rep.existence * N as f32 + 0.5) as u64;
+                }
+                None => {
+                    check(crpf.step(&z));
+                }
+            }
+        }
+    }
+    let units = (N as u64 * SEEDS) as u32;
+    let ram = size_of::<CrpfTbd<N>>();
+    let names = [
+        "CRPF-TBD frame 1 (no target), 32 seeds",
+        "CRPF-TBD frame 6, 32 seeds",
+        "CRPF-TBD frame 8 (locked), 32 seeds",
+    ];
+    for j in 0..3 {
+        let m = Measurement {
+            instructions: total[j],
+            stack_bytes: stack,
+        };
+        row(names[j], units, "particle", m, ram);
+        hprintln!(
+            "crpf N = {}: mean existence after frame {} over 32 seeds = {} / {}",
+            N,
+            FRAMES[j],
+            present[j],
+            N as u64 * SEEDS
+        );
+    }
 }
 
 /// An all-zero `static` detector. The initialiser is const-evaluated, and the const
@@ -77,6 +139,7 @@ fn rows<const N: usize>(
         model,
         size_of::<CrpfTbd<N>>(),
     );
+    crpf_rows(crpf, model);
     check(pf.reconfigure(g, SEED));
     measure_one("PF-TBD step (32 bins)", n, pf, model, size_of::<PfTbd<N>>());
     check(jott.reconfigure(g, SEED));

@@ -23,6 +23,10 @@
 //! births from `U(I_x0)`, apply the gate; (5) `P_E^k`.
 //!
 //! Implementation notes:
+//! - The existence draws of eq. 9 for `E_{k-1} = 0` particles are made by geometric
+//!   skipping (`Births`): in each pass the number of absent particles before the next
+//!   birth is drawn once (exactly geometric with parameter `Pb`), so an absent particle
+//!   that stays absent costs no draw. Present particles draw their death as before.
 //! - All weights are computed in the log domain: `ln mu_i = -q ln R_i` (eq. 4) with
 //!   `ln R_i = (p/2) ln ||.||^2` (or `logaddexp(ln lambda + ln Cbar, ...)`), then the
 //!   maximum is subtracted before `exp`, so nothing overflows `f32` even with `p = 8`.
@@ -292,6 +296,92 @@ impl ExistenceDraw {
     }
 }
 
+/// The births of eq. 9 among absent particles, drawn by geometric skipping: in one pass
+/// over the particles every `E_{k-1} = 0` particle is born independently with
+/// probability `Pb`, so the number of absent particles that stay absent before the next
+/// birth is geometric, `P(G >= g) = (1 - Pb)^g`, and one draw of `G` per birth replaces
+/// one draw per absent particle. [`gap`](Self::gap) draws `G` by inversion of its
+/// distribution function on one `u32`: `G = g` for `T_{g-1} <= u < T_g`,
+/// `T_g = 2^32 (1 - (1 - Pb)^(g+1))` (a table of 32 entries, binary search); a draw
+/// beyond the table (probability `(1 - Pb)^32`, 0.19 for `Pb = 0.05`) adds 32 and draws
+/// again, which is exact because the geometric law is memoryless. When `(1 - Pb)^32 > 1/2`
+/// (`Pb` below about 0.021) the table would loop too often, and
+/// `G = floor(ln U / ln(1 - Pb))` (`U` uniform on `(0, 1]`, 24 bits) is used instead. The
+/// same law as one draw per particle, up to the rounding of `T_g` (`f32`, relative
+/// error below `1e-5`) or the 2^-24 resolution of `U`.
+#[derive(Debug, Clone, Copy)]
+struct Births {
+    /// `T_g`, `g = 0..32`.
+    thr: [u32; 32],
+    /// `1 / ln(1 - Pb)` for the logarithmic fallback.
+    scale: f32,
+    mode: BirthMode,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum BirthMode {
+    /// `Pb = 0`: no absent particle is ever born.
+    Never,
+    /// `Pb = 1`: every absent particle is born.
+    Always,
+    Table,
+    Log,
+}
+
+impl Births {
+    fn new(chain: &crate::existence::ExistenceMarkov) -> Self {
+        let pb = chain.birth();
+        let q = 1.0 - pb;
+        let mut thr = [0u32; 32];
+        let mut tail = 1.0f32;
+        for t in thr.iter_mut() {
+            tail *= q;
+            // P(G <= g) 2^32, saturating at u32::MAX.
+            *t = ((1.0 - tail) * 4_294_967_296.0) as u32;
+        }
+        let mode = if pb <= 0.0 {
+            BirthMode::Never
+        } else if pb >= 1.0 {
+            BirthMode::Always
+        } else if tail > 0.5 {
+            BirthMode::Log
+        } else {
+            BirthMode::Table
+        };
+        Self {
+            thr,
+            scale: 1.0 / math::ln1p(-pb),
+            mode,
+        }
+    }
+
+    /// Absent particles that stay absent before the next birth.
+    #[inline(never)]
+    fn gap(&self, mut rng: Rng) -> (Rng, u32) {
+        match self.mode {
+            BirthMode::Table => {
+                let last = self.thr[31];
+                let mut base = 0u32;
+                loop {
+                    let u = rng.next_u32();
+                    if u < last {
+                        let g = self.thr.partition_point(|&t| t <= u) as u32;
+                        return (rng, base.saturating_add(g));
+                    }
+                    base = base.saturating_add(32);
+                }
+            }
+            BirthMode::Log => {
+                // ln U <= 0 and scale < 0: a non-negative product (saturating conversion).
+                let g = (math::ln(rng.uniform_open0()) * self.scale) as u32;
+                (rng, g)
+            }
+            BirthMode::Never => (rng, u32::MAX),
+            BirthMode::Always => (rng, 0),
+        }
+    }
+}
+
 /// `ln(e^a + e^b)`, exact for `-inf` arguments.
 #[inline]
 fn log_add_exp(a: f32, b: f32) -> f32 {
@@ -364,15 +454,113 @@ struct UpdateCtx<'a> {
     r_th2: f32,
     ln_free: bool,
     ln_lambda: f32,
+    zz_floor: f32,
+    draw: &'a ExistenceDraw,
+    births: &'a Births,
+}
+
+/// Step (4) over all particles, from birth gap `left`. Flags and states zipped: no index
+/// bounds check. As in `risk_pass`, the loop handles only an absent particle that stays
+/// absent; the rest is out of line. `KEEP` (`lambda > 0`, a constant so that the loop
+/// tests no flag): absent particles get their state written.
+#[inline(always)]
+fn update_loop<const KEEP: bool>(
+    ctx: &UpdateCtx<'_>,
+    st: &mut UpdateState<'_>,
+    exists: &mut [bool],
+    parts: &mut [Particle],
+    mut left: u32,
+) {
+    for (i, (flag, slot)) in exists.iter_mut().zip(parts.iter_mut()).enumerate() {
+        if !*flag && left > 0 {
+            left -= 1;
+            if KEEP {
+                ctx.absent(slot);
+            }
+            continue;
+        }
+        left = ctx.other(st, flag, slot, i, left);
+    }
+}
+
+/// What the update loop accumulates out of line.
+struct UpdateState<'a> {
+    rng: Rng,
+    /// Present particles so far; their indices are in `anc[..count]`.
+    count: usize,
+    /// Smallest cost of a present particle and its index.
+    best: f32,
+    arg: Option<usize>,
+    anc: &'a mut [u32],
 }
 
 impl UpdateCtx<'_> {
+    /// An absent particle that stays absent when `lambda > 0`: `E = 0`, `x = 0`, `h = 0`,
+    /// `C = lambda Cbar + ||z||^p`.
+    #[cold]
+    #[inline(never)]
+    fn absent(&self, slot: &mut Particle) {
+        *slot = Particle {
+            x: [0.0; 3],
+            log_c: log_cost(self.cfg, self.zz_floor, slot.log_c, self.ln_lambda),
+            zh: Complex32::new(0.0, 0.0),
+            hh: 0.0,
+        };
+    }
+
+    /// Step (4) for particle `i` when it is present at `k - 1` (`*flag`), or absent with
+    /// its birth gap run out (`left = 0`): the existence draw, then
+    /// [`update_present`](Self::update_present) or [`absent`](Self::absent). Returns the
+    /// new gap.
+    #[inline(never)]
+    fn other(
+        &self,
+        st: &mut UpdateState<'_>,
+        flag: &mut bool,
+        slot: &mut Particle,
+        i: usize,
+        mut left: u32,
+    ) -> u32 {
+        let e = *flag;
+        let mut rng = st.rng.clone();
+        let present = if e {
+            self.draw.next(true, &mut rng)
+        } else {
+            let (r, g) = self.births.gap(rng);
+            rng = r;
+            left = g;
+            true
+        };
+        if present {
+            let (r, log_c) = self.update_present(slot, e, rng);
+            rng = r;
+            if let Some(log_c) = log_c {
+                st.rng = rng;
+                *flag = true;
+                st.count += 1;
+                if let Some(s) = st.anc.get_mut(st.count - 1) {
+                    *s = i as u32;
+                }
+                if log_c < st.best {
+                    st.best = log_c;
+                    st.arg = Some(i);
+                }
+                return left;
+            }
+        }
+        st.rng = rng;
+        *flag = false;
+        if self.cfg.lambda > 0.0 {
+            self.absent(slot);
+        }
+        left
+    }
     /// Step (4) for a particle with `E_k = 1`: jitter `x ~ N(F xbar, Sigma)` if it
     /// continues (`existed`), a birth from `U(I_x0)` otherwise, then the gate (eq. 10)
     /// and the cost. On a pass writes the new state into `slot` and returns its cost;
-    /// on a rejection leaves `slot` untouched. Out of line, with the generator by value,
-    /// so that the loop over mostly absent particles keeps its state in registers.
-    #[inline(never)]
+    /// on a rejection leaves `slot` untouched. Inlined into the out-of-line
+    /// [`other`](Self::other) (one call layer per present particle, not two).
+    #[inline(always)]
     fn update_present(
         &self,
         slot: &mut Particle,
@@ -434,9 +622,9 @@ impl UpdateCtx<'_> {
 }
 
 /// Step (2) for a particle with `E_k = 1` in the prediction: `||z - h(x)||^2` of `F x`
-/// (`existed`) or of a birth from `U(I_x0)`. Out of line, generator by value (see
-/// [`UpdateCtx::update_present`]).
-#[inline(never)]
+/// (`existed`) or of a birth from `U(I_x0)`. Inlined into the out-of-line
+/// [`RiskCtx::other`].
+#[inline(always)]
 fn risk_present(
     model: &Model,
     z: &[Complex32],
@@ -459,6 +647,7 @@ fn risk_present(
 /// Its own function so that the loop over mostly absent particles keeps the generator
 /// and its pointers in registers.
 #[inline(never)]
+#[allow(clippy::too_many_arguments)]
 fn risk_pass(
     model: &Model,
     z: &[Complex32],
@@ -467,6 +656,7 @@ fn risk_pass(
     parts: &[Particle],
     out: &mut [f32],
     rng_out: &mut Rng,
+    births: &Births,
 ) -> f32 {
     let zz_floor = zz.max(f32::MIN_POSITIVE);
     let draw_table = ExistenceDraw::new(&model.chain);
@@ -474,33 +664,91 @@ fn risk_pass(
     // indexed load per particle, instead of being held in two (spilled) registers and
     // selected.
     let draw = core::hint::black_box(&draw_table);
-    let mut rng = rng_out.clone();
-    let mut dmin = f32::INFINITY;
-    // Present particles are counted (not absent ones), and the three arrays are zipped
-    // (no index, no bounds check), so the loop over mostly absent particles keeps
-    // everything in registers.
-    let mut n_present = 0usize;
+    let (rng, mut left) = births.gap(rng_out.clone());
+    let ctx = RiskCtx {
+        model,
+        z,
+        zz,
+        zz_floor,
+        draw,
+        births,
+    };
+    let mut st = RiskState {
+        rng,
+        dmin: f32::INFINITY,
+        n_present: 0,
+    };
     let n = exists.len().min(out.len()).min(parts.len());
+    // The loop itself handles only the common case, an absent particle that stays absent
+    // (geometric skipping: one decrement, no draw); everything else is out of line with
+    // the generator in memory, so the loop keeps three pointers, the counters and
+    // `||z||^2` in registers.
     for ((&e, o), p) in exists.iter().zip(out.iter_mut()).zip(parts.iter()) {
-        if draw.next(e, &mut rng) {
-            let (r, d2) = risk_present(model, z, zz, &p.x, e, rng);
-            rng = r;
-            *o = d2;
-            n_present += 1;
-            // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never
-            // NaN.
-            if d2 < dmin {
-                dmin = d2;
-            }
-        } else {
+        if !e && left > 0 {
+            left -= 1;
             *o = zz_floor;
+            continue;
         }
+        let (l, v) = ctx.other(&mut st, e, &p.x, left);
+        left = l;
+        *o = v;
     }
-    if n_present < n && zz_floor < dmin {
+    let mut dmin = st.dmin;
+    if st.n_present < n && zz_floor < dmin {
         dmin = zz_floor;
     }
-    *rng_out = rng;
+    *rng_out = st.rng;
     dmin
+}
+
+/// What the risk pass needs for a particle that is present at `k - 1` or is born.
+struct RiskCtx<'a> {
+    model: &'a Model,
+    z: &'a [Complex32],
+    zz: f32,
+    zz_floor: f32,
+    draw: &'a ExistenceDraw,
+    births: &'a Births,
+}
+
+/// What the risk pass accumulates out of line.
+struct RiskState {
+    rng: Rng,
+    dmin: f32,
+    n_present: usize,
+}
+
+impl RiskCtx<'_> {
+    /// A particle present at `k - 1` (`e`), or an absent one whose birth gap ran out
+    /// (`left = 0`): its predicted existence, its residual (`||z||^2` floored if absent)
+    /// and the new gap.
+    #[inline(never)]
+    fn other(&self, st: &mut RiskState, e: bool, x: &[f32; 3], mut left: u32) -> (u32, f32) {
+        let mut rng = st.rng.clone();
+        let present = if e {
+            self.draw.next(true, &mut rng)
+        } else {
+            let (r, g) = self.births.gap(rng);
+            rng = r;
+            left = g;
+            true
+        };
+        let v = if present {
+            let (r, d2) = risk_present(self.model, self.z, self.zz, x, e, rng);
+            rng = r;
+            st.n_present += 1;
+            // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never
+            // NaN.
+            if d2 < st.dmin {
+                st.dmin = d2;
+            }
+            d2
+        } else {
+            self.zz_floor
+        };
+        st.rng = rng;
+        (left, v)
+    }
 }
 
 /// CRPF-TBD with `N` particles.
@@ -521,6 +769,8 @@ pub struct CrpfTbd<const N: usize> {
     frame: u32,
     /// `q p / 2` when the ln-free weight path applies.
     int_exponent: Option<u32>,
+    /// The birth-gap sampler of the model's existence chain.
+    births: Births,
 }
 
 impl<const N: usize> CrpfTbd<N> {
@@ -534,6 +784,7 @@ impl<const N: usize> CrpfTbd<N> {
         }
         let model = cfg.validate()?;
         let int_exponent = int_exponent(&cfg);
+        let births = Births::new(&model.chain);
         let mut s = Self {
             cfg,
             model,
@@ -547,6 +798,7 @@ impl<const N: usize> CrpfTbd<N> {
             rng: Rng::seed_from_u64(seed),
             frame: 0,
             int_exponent,
+            births,
         };
         s.reset(seed);
         Ok(s)
@@ -564,6 +816,7 @@ impl<const N: usize> CrpfTbd<N> {
         }
         let model = cfg.validate()?;
         self.int_exponent = int_exponent(&cfg);
+        self.births = Births::new(&model.chain);
         self.cfg = cfg;
         self.model = model;
         self.reset(seed);
@@ -614,6 +867,7 @@ impl<const N: usize> CrpfTbd<N> {
             &self.parts,
             &mut self.log_w,
             &mut self.rng,
+            &self.births,
         );
         if let Some(n) = self.int_exponent {
             // w_i = (min d2 / d2_i)^(q p / 2): eq. 4 normalised by its largest weight,
@@ -711,64 +965,39 @@ impl<const N: usize> CrpfTbd<N> {
 
         // Step (4): update existence, jitter / births, gate, costs.
         let zz_floor = zz.max(f32::MIN_POSITIVE);
+        let draw_table = ExistenceDraw::new(&self.model.chain);
         let ctx = UpdateCtx {
             model: &self.model,
             cfg: &self.cfg,
             z,
             zz,
+            zz_floor,
             norm_m2: zz + self.prev_zz,
             r_th2: self.cfg.r_th * self.cfg.r_th,
             ln_free: self.int_exponent.is_some(),
             ln_lambda,
+            draw: &draw_table,
+            births: &self.births,
         };
         // `anc` (free after resampling) collects the indices of the E = 1 particles, so
-        // the estimates visit only those; the min-cost one is tracked here.
-        let mut count = 0usize;
-        let mut best = f32::INFINITY;
-        let mut arg = None;
-        let mut rng = self.rng.clone();
-        let draw_table = ExistenceDraw::new(&self.model.chain);
-        // Opaque reference: one indexed load per particle (see `risk_pass`).
-        let draw = core::hint::black_box(&draw_table);
+        // the estimates visit only those; the min-cost one is tracked too.
+        let (rng, left) = ctx.births.gap(self.rng.clone());
+        let mut st = UpdateState {
+            rng,
+            count: 0,
+            best: f32::INFINITY,
+            arg: None,
+            anc: &mut self.anc,
+        };
         // With lambda = 0 an absent particle's state is never read again: only its flag
-        // is written.
-        let keep_absent = self.cfg.lambda > 0.0;
-        // Flags and states zipped: no index bounds check in the loop.
-        for (i, (flag, slot)) in self
-            .exists
-            .iter_mut()
-            .zip(self.parts.iter_mut())
-            .enumerate()
-        {
-            let e = *flag;
-            if draw.next(e, &mut rng) {
-                let (r, log_c) = ctx.update_present(slot, e, rng);
-                rng = r;
-                if let Some(log_c) = log_c {
-                    *flag = true;
-                    count += 1;
-                    if let Some(s) = self.anc.get_mut(count - 1) {
-                        *s = i as u32;
-                    }
-                    if log_c < best {
-                        best = log_c;
-                        arg = Some(i);
-                    }
-                    continue;
-                }
-            }
-            *flag = false;
-            if keep_absent {
-                // E = 0: x = 0, h = 0, C = lambda Cbar + ||z||^p.
-                *slot = Particle {
-                    x: [0.0; 3],
-                    log_c: log_cost(&self.cfg, zz_floor, slot.log_c, ln_lambda),
-                    zh: Complex32::new(0.0, 0.0),
-                    hh: 0.0,
-                };
-            }
+        // is written (and it is already `false`).
+        if self.cfg.lambda > 0.0 {
+            update_loop::<true>(&ctx, &mut st, &mut self.exists, &mut self.parts, left);
+        } else {
+            update_loop::<false>(&ctx, &mut st, &mut self.exists, &mut self.parts, left);
         }
-        self.rng = rng;
+        let (count, best, arg) = (st.count, st.best, st.arg);
+        self.rng = st.rng;
 
         let (mean, min) = self.estimates(count, best, arg);
         self.prev[..m].copy_from_slice(z);
@@ -851,6 +1080,50 @@ impl<const N: usize> FrameDetector for CrpfTbd<N> {
 mod tests {
     use super::*;
     use std::vec::Vec;
+
+    #[test]
+    fn birth_gaps_are_geometric() {
+        // Births by geometric skipping against the law of one Bernoulli(Pb) draw per
+        // absent particle: over 400 000 absent particles the birth rate and the law of
+        // the gap (P(G = 0) = Pb, P(G >= 20) = (1 - Pb)^20) must match within 5 binomial
+        // standard deviations (sd of the rate 3.4e-4 at Pb = 0.05), i.e. an error of
+        // 1.7e-3 in the rate fails.
+        // 0.01 takes the logarithmic path, 0.05 and 0.3 the table.
+        for pb in [0.01f32, 0.05, 0.3] {
+            let chain = crate::existence::ExistenceMarkov::new(pb, 0.05).unwrap();
+            let b = Births::new(&chain);
+            let mut rng = Rng::seed_from_u64(3);
+            let (mut births, mut absent) = (0u64, 0u64);
+            let (mut zero, mut long, mut gaps) = (0u64, 0u64, 0u64);
+            while absent < 400_000 {
+                let (r, g) = b.gap(rng);
+                rng = r;
+                gaps += 1;
+                zero += (g == 0) as u64;
+                long += (g >= 20) as u64;
+                absent += g as u64 + 1;
+                births += 1;
+            }
+            let p = pb as f64;
+            let check = |got: f64, want: f64, n: u64| {
+                let sd = (want * (1.0 - want) / n as f64).sqrt();
+                assert!((got - want).abs() < 5.0 * sd, "pb {pb}: {got} vs {want}");
+            };
+            check(births as f64 / absent as f64, p, absent);
+            check(zero as f64 / gaps as f64, p, gaps);
+            check(long as f64 / gaps as f64, (1.0 - p).powi(20), gaps);
+        }
+        // Pb = 0: never born; Pb = 1: always born.
+        let never = Births::new(&crate::existence::ExistenceMarkov::new(0.0, 0.05).unwrap());
+        assert_eq!(never.gap(Rng::seed_from_u64(1)).1, u32::MAX);
+        let always = Births::new(&crate::existence::ExistenceMarkov::new(1.0, 0.05).unwrap());
+        let mut rng = Rng::seed_from_u64(1);
+        for _ in 0..1000 {
+            let (r, g) = always.gap(rng);
+            rng = r;
+            assert_eq!(g, 0);
+        }
+    }
 
     #[test]
     fn fused_systematic_equals_resample() {

@@ -85,7 +85,53 @@ impl Args {
         }
         a
     }
+
+    /// Checks every argument before any work is done (so a bad combination fails at
+    /// once, not after the H0 runs): `--pfa` in `(0, 1)`; a supported `--particles`; at
+    /// least one H1 trial; enough `--h0-trials` that the calibration's halves resolve
+    /// `--pfa` (each half must hold at least `1 / pfa` runs); a valid `--snr-db` grid;
+    /// with `--sweeps`, more than 10 sweep H0 runs and at least one sweep H1 run.
+    pub fn validate(&self) -> Result<()> {
+        let a = self.effective();
+        ensure!(
+            a.pfa > 0.0 && a.pfa < 1.0,
+            "--pfa must lie in (0, 1), got {}",
+            a.pfa
+        );
+        ensure!(
+            PARTICLES.contains(&a.particles),
+            "--particles {} is not supported (use {:?})",
+            a.particles,
+            PARTICLES
+        );
+        ensure!(a.trials >= 1, "--trials must be at least 1");
+        let need = 2 * (1.0 / a.pfa).ceil() as usize;
+        ensure!(
+            a.h0_trials >= need,
+            "--h0-trials {} cannot resolve --pfa {}: the threshold is checked on an \
+             independent half of the H0 runs, so each half needs at least {} runs \
+             (use --h0-trials {} or more)",
+            a.h0_trials,
+            a.pfa,
+            need / 2,
+            need
+        );
+        parse_grid(&a.snr_db)?;
+        if a.sweeps {
+            ensure!(
+                a.sweep_h0_trials > 10,
+                "--sweep-h0-trials must be more than 10 (the sweeps' Pfa is at least \
+                 10 / sweep-h0-trials), got {}",
+                a.sweep_h0_trials
+            );
+            ensure!(a.sweep_trials >= 1, "--sweep-trials must be at least 1");
+        }
+        Ok(())
+    }
 }
+
+/// Particle counts `faint reproduce crpf` is compiled for (see [`run_stats`]).
+pub const PARTICLES: [usize; 7] = [100, 250, 500, 1000, 2000, 4000, 6000];
 
 /// Parses `a:b:step` into the grid `a, a + step, ..., <= b`.
 pub fn parse_grid(s: &str) -> Result<Vec<f64>> {
@@ -328,6 +374,7 @@ pub fn calibration(h0: &[f64], pfa: f64) -> Result<(Threshold, Proportion)> {
 
 /// `faint reproduce crpf`.
 pub fn run(args: &Args) -> Result<()> {
+    args.validate()?;
     let a = args.effective();
     let grid = parse_grid(&a.snr_db)?;
     let sc = Othr::default();
