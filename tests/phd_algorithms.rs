@@ -154,7 +154,7 @@ fn dbscan_rejects_bad_input() {
 }
 
 /// Reference ranks by repeated peeling of the non-dominated set.
-fn brute_ranks(f: &[[f32; 4]], m: usize) -> Vec<u32> {
+fn brute_ranks<const M: usize>(f: &[[f32; M]], m: usize) -> Vec<u32> {
     let n = f.len();
     let mut rank = vec![u32::MAX; n];
     let mut r = 0;
@@ -252,30 +252,10 @@ fn divide_and_conquer_ranks_match_brute_force_with_ties_and_many_objectives() {
             fenwick: &mut fen,
         };
         let fronts = rank_sorted(n, m, |p, j| f[p][j], &mut rank, ws);
-        let f4: Vec<[f32; 8]> = f.clone();
-        let want = brute_ranks_n(&f4, m);
+        let want = brute_ranks(&f, m);
         assert_eq!(rank, want, "case {case} (n={n}, m={m}, levels={levels})");
         assert_eq!(fronts as u32, want.iter().max().unwrap() + 1);
     }
-}
-
-fn brute_ranks_n(f: &[[f32; 8]], m: usize) -> Vec<u32> {
-    let n = f.len();
-    let mut rank = vec![u32::MAX; n];
-    let mut r = 0;
-    while rank.contains(&u32::MAX) {
-        let cur: Vec<usize> = (0..n)
-            .filter(|&i| {
-                rank[i] == u32::MAX
-                    && !(0..n).any(|j| rank[j] == u32::MAX && dominates(&f[j][..m], &f[i][..m]))
-            })
-            .collect();
-        for i in cur {
-            rank[i] = r;
-        }
-        r += 1;
-    }
-    rank
 }
 
 mod swarm_props {

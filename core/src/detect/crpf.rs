@@ -443,6 +443,27 @@ fn int_exponent(cfg: &CrpfConfig) -> Option<u32> {
     }
 }
 
+/// Eq. 9 for a particle that is not an absent one staying absent: present at `k - 1`
+/// (`e`), one draw decides survival; absent with its birth gap run out, it is born and
+/// the next gap is drawn into `left`.
+#[inline(always)]
+fn predicted_existence(
+    draw: &ExistenceDraw,
+    births: &Births,
+    e: bool,
+    rng: &mut Rng,
+    left: &mut u32,
+) -> bool {
+    if e {
+        draw.next(true, rng)
+    } else {
+        let (r, g) = births.gap(rng.clone());
+        *rng = r;
+        *left = g;
+        true
+    }
+}
+
 /// What step (4) needs for one particle that exists after the existence draw.
 struct UpdateCtx<'a> {
     model: &'a Model,
@@ -523,14 +544,7 @@ impl UpdateCtx<'_> {
     ) -> u32 {
         let e = *flag;
         let mut rng = st.rng.clone();
-        let present = if e {
-            self.draw.next(true, &mut rng)
-        } else {
-            let (r, g) = self.births.gap(rng);
-            rng = r;
-            left = g;
-            true
-        };
+        let present = predicted_existence(self.draw, self.births, e, &mut rng, &mut left);
         if present {
             let (r, log_c) = self.update_present(slot, e, rng);
             rng = r;
@@ -725,14 +739,7 @@ impl RiskCtx<'_> {
     #[inline(never)]
     fn other(&self, st: &mut RiskState, e: bool, x: &[f32; 3], mut left: u32) -> (u32, f32) {
         let mut rng = st.rng.clone();
-        let present = if e {
-            self.draw.next(true, &mut rng)
-        } else {
-            let (r, g) = self.births.gap(rng);
-            rng = r;
-            left = g;
-            true
-        };
+        let present = predicted_existence(self.draw, self.births, e, &mut rng, &mut left);
         let v = if present {
             let (r, d2) = risk_present(self.model, self.z, self.zz, x, e, rng);
             rng = r;
