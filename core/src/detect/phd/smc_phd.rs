@@ -23,7 +23,7 @@
 
 use super::dbscan::{Dbscan, DbscanParams};
 use super::kmeans::KMeans;
-use super::pso::{PsoConfig, Swarm};
+use super::pso::{PsoConfig, Swarm, SwarmMembers};
 use crate::math::{self, KahanSum};
 use crate::model::power_cube::{
     AxisWeights, CubeGeometry, PointSpread, PowerCube, RadarCoords, DEG_PER_RAD,
@@ -446,7 +446,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         self.add_births();
         if let Some(pso) = self.cfg.pso {
             self.select_points(&cube, n_surv, pso.points);
-            let (sw, gens) = self.swarm_step(&pso);
+            let (sw, gens) = self.swarm_step(&pso, n_surv);
             report.swarm = sw;
             report.pso_generations = gens;
         }
@@ -810,7 +810,9 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         (best.1 * math::cos(b), best.1 * math::sin(b))
     }
 
-    fn swarm_step(&mut self, pso: &PsoConfig) -> (usize, usize) {
+    /// The swarm over the gated particles (from `n_surv` on, this frame's births, when
+    /// `pso.members` is [`SwarmMembers::Births`]).
+    fn swarm_step(&mut self, pso: &PsoConfig, n_surv: usize) -> (usize, usize) {
         let m = self.n_z;
         if m == 0 {
             return (0, 0);
@@ -828,19 +830,43 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             best
         };
         self.swarm.clear();
-        let mut before = [0.0f32; M];
-        let mut n_s = 0usize;
-        for i in 0..self.n {
+        let first = match pso.members {
+            SwarmMembers::All | SwarmMembers::Unconverged => 0,
+            SwarmMembers::Births => n_surv.min(self.n),
+        };
+        let top = if pso.members == SwarmMembers::Unconverged {
+            pso.threshold
+        } else {
+            f32::INFINITY
+        };
+        // The gated particles (index in `order`, nearest point in `key`).
+        let mut gated = 0usize;
+        for i in first..self.n {
             let p = [self.x[i][0], self.x[i][2]];
             let (k, d) = nearest(p, &self.zpts[..m]);
-            if math::exp(-d * inv) >= pso.gate {
-                if !self.swarm.push(p, self.w[i], i as u32, k as u16) {
-                    break;
-                }
-                self.order[n_s] = i as u32;
-                before[k] += self.w[i];
-                n_s += 1;
+            let fit = math::exp(-d * inv);
+            if fit >= pso.gate && fit < top {
+                self.order[gated] = i as u32;
+                self.key[gated] = k as u32;
+                gated += 1;
             }
+        }
+        // At most `max_members` of them (and the swarm's capacity), evenly spaced:
+        // member `j` is gated particle `floor(j gated / take)`.
+        let take = gated.min(pso.max_members).min(Swarm::<S, M>::capacity());
+        let mut before = [0.0f32; M];
+        let mut n_s = 0usize;
+        for j in 0..take {
+            let g = (j as u64 * gated as u64 / take as u64) as usize;
+            let (i, k) = (self.order[g] as usize, self.key[g] as usize);
+            let p = [self.x[i][0], self.x[i][2]];
+            if !self.swarm.push(p, self.w[i], i as u32, k as u16) {
+                break;
+            }
+            // `g >= j`: slot `j` of `order` is free once read.
+            self.order[n_s] = i as u32;
+            before[k.min(M - 1)] += self.w[i];
+            n_s += 1;
         }
         if n_s == 0 {
             return (0, 0);
