@@ -6,8 +6,8 @@
 //! `cargo run --release --example phd_frame_times [VARIANT [force]]` (VARIANT: `phd`,
 //! `kmeans`, `dbscan`, `all`; default all three; `force`: the swarm's stop threshold is
 //! set above the largest fitness, so every frame with a swarm runs `max_generations`
-//! (20) generations instead of `gen = 10` and stopping: the swarm's worst case). `FAINT_MEMBERS=births`: the swarm moves the births only
-//! (`SwarmMembers::Births`). `FAINT_RUNS=1` measures the first run only (for
+//! (20) generations instead of `gen = 10` and stopping: the swarm's worst case). `FAINT_SWARM_CAP=N`: at most `N` particles in the
+//! swarm (`PsoConfig::max_members`; 0 = all gated particles; default the preset's 512). `FAINT_RUNS=1` measures the first run only (for
 //! instruction profiles under callgrind). CPU time is the thread's, so time spent waiting for a
 //! core on a loaded machine is not counted (Linux x86_64 / aarch64 only).
 use faint_core::rng::Rng;
@@ -65,13 +65,12 @@ fn run() {
             let mut rng = Rng::seed_from_u64(70 + seed);
             let truth = sc.truth(&mut rng);
             let mut cfg = sc.config(v);
-            if let Some(p) = cfg.pso.as_mut() {
-                match std::env::var("FAINT_MEMBERS").as_deref() {
-                    Ok("births") => p.members = faint_core::detect::phd::SwarmMembers::Births,
-                    Ok("unconverged") => {
-                        p.members = faint_core::detect::phd::SwarmMembers::Unconverged
-                    }
-                    _ => {}
+            if let Some(cap) = std::env::var("FAINT_SWARM_CAP")
+                .ok()
+                .and_then(|c| c.parse::<usize>().ok())
+            {
+                if let Some(p) = cfg.pso.as_mut() {
+                    p.max_members = if cap == 0 { usize::MAX } else { cap };
                 }
             }
             if force {

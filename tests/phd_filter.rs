@@ -76,6 +76,15 @@ fn invalid_configurations_are_typed_errors() {
                 requested: 11
             }
         ));
+        let mut c = sc.config(Variant::PsoKMeans);
+        c.pso = Some(PsoConfig {
+            max_members: 0,
+            ..PsoConfig::paper()
+        });
+        assert_eq!(
+            HostFilter::new(c, 1).unwrap_err(),
+            Error::InvalidConfig("pso")
+        );
         for bad in [
             |c: &mut faint::core::detect::phd::Config| c.noise_var = 0.0,
             |c: &mut faint::core::detect::phd::Config| c.p_survival = 1.5,
@@ -90,6 +99,42 @@ fn invalid_configurations_are_typed_errors() {
                 Error::InvalidConfig(_)
             ));
         }
+    });
+}
+
+/// `PsoConfig::max_members` bounds the swarm in every frame, and binds: over the first
+/// 16 frames at 9 dB (targets 3, then 1 and 5 alive), uncapped frames have more gated
+/// particles than the cap, so the cap is what limits them.
+#[test]
+fn the_swarm_cap_bounds_every_frame() {
+    big_stack(|| {
+        let sc = SixTargets::new(9.0);
+        let swarm_sizes = |cap: usize| {
+            let mut rng = Rng::seed_from_u64(8);
+            let truth = sc.truth(&mut rng);
+            let mut c = sc.config(Variant::PsoKMeans);
+            c.pso = Some(PsoConfig {
+                max_members: cap,
+                ..PsoConfig::paper()
+            });
+            let mut f = Box::new(HostFilter::new(c, 3).unwrap());
+            let mut cube = Vec::new();
+            let mut sizes = Vec::new();
+            for frame in truth.iter().take(16) {
+                sc.cube(frame, &mut rng, &mut cube);
+                sizes.push(f.step(&cube).unwrap().swarm);
+            }
+            sizes
+        };
+        let capped = swarm_sizes(100);
+        let free = swarm_sizes(usize::MAX);
+        println!("swarm per frame, cap 100: {capped:?}; uncapped: {free:?}");
+        assert!(capped.iter().all(|&s| s <= 100), "{capped:?}");
+        assert!(
+            capped.iter().filter(|&&s| s == 100).count() >= 4,
+            "{capped:?}"
+        );
+        assert!(free.iter().any(|&s| s > 100), "{free:?}");
     });
 }
 
@@ -164,19 +209,6 @@ fn same_seed_same_output() {
         };
         assert_eq!(run(), run());
     });
-}
-
-#[test]
-fn a_4096_particle_filter_fits_in_1_mib_of_static_ram() {
-    // Firmware configuration: 4096 particles (e.g. 3 targets x 1000 + 500 births + slack),
-    // a swarm of 2048 parents, 8 measurement points, 8 targets. The cube itself is the
-    // caller's buffer and is not counted.
-    type Fw = SmcPhdTbd<4096, 4096, 8, 8>;
-    let bytes = std::mem::size_of::<Fw>();
-    println!("SmcPhdTbd<4096, 4096, 8, 8>: {bytes} bytes");
-    assert!(bytes < 1 << 20, "{bytes}");
-    type Host = HostFilter;
-    println!("HostFilter: {} bytes", std::mem::size_of::<Host>());
 }
 
 /// Count error and OSPA of `variants` at 9 dB, frames 20-28 (all six targets alive since

@@ -1,8 +1,8 @@
 //! Cost of PHD-TBD, PSO-PHD-TBD (K-means) and PSO-PHD-TBD (DBSCAN) (paper 002) on the
-//! Cortex-M4F, in a configuration that fits 1 MiB of RAM: `SmcPhdTbd<4096, 4096, 8, 8>`
-//! (4096 particles, a 4096-entry swarm so up to 2048 particles move, 8 measurement points,
-//! 8 targets) with the `six-targets` preset's particle counts (1000 per target, 500
-//! births), on the shared three-target 9 dB scene of `faint_golden::phd` in its
+//! Cortex-M4F, in a configuration that fits 1 MiB of RAM: `SmcPhdTbd<6144, 1024, 8, 8>`
+//! (6144 particles, e.g. five targets at the preset's 1000 plus 500 births; a 1024-entry
+//! swarm, so the preset's 512 particles move; 8 measurement points, 8 targets) with the
+//! `six-targets` preset's particle counts (1000 per target, 500 births), on the shared three-target 9 dB scene of `faint_golden::phd` in its
 //! 32 x 32 x 32-cell firmware window (range x Doppler x azimuth around the targets).
 //!
 //! Each variant restarts the one static filter with `reconfigure` and runs the scene's
@@ -30,7 +30,7 @@ const PER_TARGET: usize = 1000;
 const BIRTHS: usize = 500;
 const CELLS: usize = FIRMWARE_WINDOW.len();
 
-type Det = SmcPhdTbd<4096, 4096, 8, 8>;
+type Det = SmcPhdTbd<6144, 1024, 8, 8>;
 
 // SAFETY: the const evaluator rejects (compile error) a zero bit pattern that is not a
 // valid value of every field of `Det` (enum tags, `Option`, `bool`, the generator's
@@ -48,7 +48,7 @@ pub fn run() {
     let det = DET.take();
     let buf = CUBE.take();
     hprintln!(
-        "PHD-TBD statics: SmcPhdTbd<4096, 4096, 8, 8> {} B + cube window ({} cells) {} B = {} B",
+        "PHD-TBD statics: SmcPhdTbd<6144, 1024, 8, 8> {} B + cube window ({} cells) {} B = {} B",
         size_of::<Det>(),
         CELLS,
         size_of::<[f32; CELLS]>(),

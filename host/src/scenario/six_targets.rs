@@ -48,7 +48,7 @@
 //!   is how 9 dB tracks were lost (per-frame diagnostics: `examples/phd_diag.rs`).
 
 use faint_core::detect::phd::{
-    BirthComponent, BirthMode, BirthModel, Config, DbscanParams, Extractor, PsoConfig, SwarmMembers,
+    BirthComponent, BirthMode, BirthModel, Config, DbscanParams, Extractor, PsoConfig,
 };
 use faint_core::model::power_cube::{CubeGeometry, PointSpread, RadarCoords};
 use faint_core::rng::Rng;
@@ -102,13 +102,6 @@ pub const TABLE1: [TargetSpec; 6] = [
 
 pub use faint_core::detect::phd::Variant;
 
-fn debug_str<T: core::fmt::Debug, S: serde::Serializer>(
-    v: &T,
-    s: S,
-) -> core::result::Result<S::Ok, S::Error> {
-    s.serialize_str(&format!("{v:?}"))
-}
-
 /// The preset.
 #[derive(Debug, Clone, Serialize)]
 pub struct SixTargets {
@@ -137,10 +130,9 @@ pub struct SixTargets {
     /// Two-frame birth velocity: `BirthMode::Measurement::pair_max_speed` (m/s; 0 = off,
     /// the preset's default; `faint reproduce psophd --birth-pair-speed`).
     pub birth_pair_max_speed: f64,
-    /// Which particles the swarm moves (`PsoConfig::members`; all gated particles by
-    /// default; `faint reproduce psophd --swarm-members`).
-    #[serde(serialize_with = "debug_str")]
-    pub swarm_members: SwarmMembers,
+    /// At most this many particles move in the swarm per frame (`PsoConfig::max_members`,
+    /// 512 by default; `faint reproduce psophd --swarm-cap`, 0 = all gated particles).
+    pub swarm_cap: usize,
     /// Targets.
     pub targets: Vec<TargetSpec>,
     /// DBSCAN radius `E` (m) and density threshold `Th_min`.
@@ -178,7 +170,7 @@ impl SixTargets {
             particles_per_target: 1000,
             birth_particles: 500,
             birth_pair_max_speed: 0.0,
-            swarm_members: SwarmMembers::All,
+            swarm_cap: PsoConfig::paper().max_members,
             targets: TABLE1.to_vec(),
             dbscan: (5.0, 10),
             ospa: (50.0, 2.0),
@@ -346,11 +338,11 @@ impl SixTargets {
             pso: match variant {
                 Variant::PhdTbd => None,
                 _ => Some(PsoConfig {
-                    members: self.swarm_members,
-                    max_members: std::env::var("FAINT_CAP")
-                        .ok()
-                        .and_then(|v| v.parse().ok())
-                        .unwrap_or(usize::MAX),
+                    max_members: if self.swarm_cap == 0 {
+                        usize::MAX
+                    } else {
+                        self.swarm_cap
+                    },
                     ..PsoConfig::paper()
                 }),
             },

@@ -20,7 +20,7 @@ mod variant;
 
 pub use dbscan::{Dbscan, DbscanParams};
 pub use kmeans::KMeans;
-pub use pso::{PsoConfig, Swarm, SwarmMembers};
+pub use pso::{PsoConfig, Swarm};
 pub use smc_phd::{
     BirthComponent, BirthMode, BirthModel, Config, Estimate, Extractor, Report, SmcPhdTbd,
     MAX_BIRTH_COMPONENTS,

@@ -23,7 +23,7 @@
 
 use super::dbscan::{Dbscan, DbscanParams};
 use super::kmeans::KMeans;
-use super::pso::{PsoConfig, Swarm, SwarmMembers};
+use super::pso::{PsoConfig, Swarm};
 use crate::math::{self, KahanSum};
 use crate::model::power_cube::{
     AxisWeights, CubeGeometry, PointSpread, PowerCube, RadarCoords, DEG_PER_RAD,
@@ -195,6 +195,7 @@ impl Config {
         }
         if let Some(p) = &self.pso {
             if p.points == 0
+                || p.max_members == 0
                 || !pos(p.fitness_scale)
                 || !nonneg(p.mutation)
                 || ![p.inertia, p.c1, p.c2, p.step, p.threshold, p.gate]
@@ -446,7 +447,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         self.add_births();
         if let Some(pso) = self.cfg.pso {
             self.select_points(&cube, n_surv, pso.points);
-            let (sw, gens) = self.swarm_step(&pso, n_surv);
+            let (sw, gens) = self.swarm_step(&pso);
             report.swarm = sw;
             report.pso_generations = gens;
         }
@@ -810,9 +811,8 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         (best.1 * math::cos(b), best.1 * math::sin(b))
     }
 
-    /// The swarm over the gated particles (from `n_surv` on, this frame's births, when
-    /// `pso.members` is [`SwarmMembers::Births`]).
-    fn swarm_step(&mut self, pso: &PsoConfig, n_surv: usize) -> (usize, usize) {
+    /// The swarm over at most `pso.max_members` of the gated particles.
+    fn swarm_step(&mut self, pso: &PsoConfig) -> (usize, usize) {
         let m = self.n_z;
         if m == 0 {
             return (0, 0);
@@ -830,22 +830,12 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             best
         };
         self.swarm.clear();
-        let first = match pso.members {
-            SwarmMembers::All | SwarmMembers::Unconverged => 0,
-            SwarmMembers::Births => n_surv.min(self.n),
-        };
-        let top = if pso.members == SwarmMembers::Unconverged {
-            pso.threshold
-        } else {
-            f32::INFINITY
-        };
         // The gated particles (index in `order`, nearest point in `key`).
         let mut gated = 0usize;
-        for i in first..self.n {
+        for i in 0..self.n {
             let p = [self.x[i][0], self.x[i][2]];
             let (k, d) = nearest(p, &self.zpts[..m]);
-            let fit = math::exp(-d * inv);
-            if fit >= pso.gate && fit < top {
+            if math::exp(-d * inv) >= pso.gate {
                 self.order[gated] = i as u32;
                 self.key[gated] = k as u32;
                 gated += 1;
