@@ -1038,17 +1038,39 @@ impl<const N: usize> CrpfTbd<N> {
         let q = self.cfg.q;
         let top = -q * best;
         let n = self.int_exponent;
-        let mut s = 0.0f32;
-        let mut acc = [0.0f32; 3];
         // Doppler is averaged relative to the min-cost particle so the wrap at the band
         // edge does not split the mean.
         let ref_fd = self.parts[a].x[0];
         let width = self.model.motion.band.1 - self.model.motion.band.0;
+        // One loop per weight form (the form is not re-tested per particle).
+        let (s, acc) = match n {
+            Some(4) => self.weighted_sums(live, ref_fd, width, |c| powi(best / c, 4)),
+            Some(n) => self.weighted_sums(live, ref_fd, width, |c| powi(best / c, n)),
+            None => self.weighted_sums(live, ref_fd, width, |c| math::exp(-q * c - top)),
+        };
+        // s >= 1 (the min-cost particle contributes exp(0)).
+        let mean = [
+            self.model.motion.wrap(ref_fd + acc[0] / s),
+            acc[1] / s,
+            acc[2] / s,
+        ];
+        (Some(mean), Some(self.parts[a].x))
+    }
+
+    /// `sum_i w_i` and `sum_i w_i [fd_i - ref_fd (wrapped), fda_i, A_i]` over the particles
+    /// `live`, `w_i = weight(log_c_i)`.
+    #[inline(always)]
+    fn weighted_sums(
+        &self,
+        live: &[u32],
+        ref_fd: f32,
+        width: f32,
+        weight: impl Fn(f32) -> f32,
+    ) -> (f32, [f32; 3]) {
+        let mut s = 0.0f32;
+        let mut acc = [0.0f32; 3];
         for p in live.iter().filter_map(|&i| self.parts.get(i as usize)) {
-            let w = match n {
-                Some(n) => powi(best / p.log_c, n),
-                None => math::exp(-q * p.log_c - top),
-            };
+            let w = weight(p.log_c);
             let mut dfd = p.x[0] - ref_fd;
             if dfd > 0.5 * width {
                 dfd -= width;
@@ -1060,13 +1082,7 @@ impl<const N: usize> CrpfTbd<N> {
             acc[2] += w * p.x[2];
             s += w;
         }
-        // s >= 1 (the min-cost particle contributes exp(0)).
-        let mean = [
-            self.model.motion.wrap(ref_fd + acc[0] / s),
-            acc[1] / s,
-            acc[2] / s,
-        ];
-        (Some(mean), Some(self.parts[a].x))
+        (s, acc)
     }
 }
 

@@ -124,6 +124,8 @@ impl Projection {
 #[derive(Debug, Clone)]
 pub struct DopplerModel {
     m: usize,
+    /// `m as f32` (converted once, not per particle).
+    m_f32: f32,
     ts: f32,
     window: Window,
     /// `rows[i0][j]`: the table points `t = i0 + (SPAN - 1 - j) S` and `t + 1` of bin `j`
@@ -169,6 +171,7 @@ impl DopplerModel {
         }
         Ok(Self {
             m,
+            m_f32: m as f32,
             ts,
             window,
             rows,
@@ -218,7 +221,7 @@ impl DopplerModel {
     /// `b0 - J (mod m)`; returns `(first_bin, interpolation row, fraction)`.
     #[inline]
     fn locate(&self, fd: f32) -> (usize, &Row, f32) {
-        let pos = fd * self.ts * self.m as f32;
+        let pos = fd * self.ts * self.m_f32;
         let pos = if pos.is_finite() { pos } else { 0.0 };
         let (b, bi) = if pos > -LARGE && pos < LARGE {
             // libm's roundf, trunc(x + copysign(0.5 - eps/4, x)), inlined.
@@ -315,10 +318,17 @@ impl DopplerModel {
 /// fixed-size arrays, fully unrolled, no bounds checks.
 #[inline(always)]
 fn kernel<const IM: bool>(row: &Row, zs: &[Complex32; SPAN], frac: f32) -> (f32, f32, f32) {
-    let mut zr = 0.0f32;
-    let mut zi = 0.0f32;
-    let mut hh = 0.0f32;
-    for (c, zb) in row.iter().zip(zs.iter()) {
+    // The sums start from the first bin's terms instead of 0.0 + them: the same values,
+    // except that a sum of signed zeros may keep its sign (-0.0 instead of +0.0), which
+    // no cost, gate or weight can tell apart (each is squared or added first).
+    let (c, zb) = (&row[0], &zs[0]);
+    let hr = c[0] + c[2] * frac;
+    let hi = c[1] + c[3] * frac;
+    let mut zr = zb.re * hr + zb.im * hi;
+    let mut zi = if IM { zb.re * hi - zb.im * hr } else { 0.0 };
+    let mut hh = hr * hr + hi * hi;
+    for j in 1..SPAN {
+        let (c, zb) = (&row[j], &zs[j]);
         let hr = c[0] + c[2] * frac;
         let hi = c[1] + c[3] * frac;
         // conj(z) h
