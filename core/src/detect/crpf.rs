@@ -55,7 +55,9 @@
 //! [`CrpfTbd::reconfigure`].
 
 use crate::math::{self, KahanSum};
-use crate::model::doppler::{check_frame, FrameDetector, Model, ModelConfig, TbdReport, MAX_BINS};
+use crate::model::doppler::{
+    check_frame, FrameDetector, Model, ModelConfig, ProjectionCache, TbdReport, MAX_BINS,
+};
 use crate::particles::{resample, Scheme};
 use crate::rng::Rng;
 use crate::{Complex32, Error, Result};
@@ -513,6 +515,7 @@ struct UpdateState<'a> {
     best: f32,
     arg: Option<usize>,
     anc: &'a mut [u32],
+    cache: &'a mut ProjectionCache,
 }
 
 impl UpdateCtx<'_> {
@@ -546,7 +549,7 @@ impl UpdateCtx<'_> {
         let mut rng = st.rng.clone();
         let present = predicted_existence(self.draw, self.births, e, &mut rng, &mut left);
         if present {
-            let (r, log_c) = self.update_present(slot, e, rng);
+            let (r, log_c) = self.update_present(slot, e, rng, st.cache);
             rng = r;
             if let Some(log_c) = log_c {
                 st.rng = rng;
@@ -580,6 +583,7 @@ impl UpdateCtx<'_> {
         slot: &mut Particle,
         existed: bool,
         mut rng: Rng,
+        cache: &mut ProjectionCache,
     ) -> (Rng, Option<f32>) {
         let par = *slot;
         let motion = &self.model.motion;
@@ -604,7 +608,13 @@ impl UpdateCtx<'_> {
                 0.0,
             )
         };
-        let pr = self.model.obs.project(self.z, x[0], x[2]);
+        let pr = if existed {
+            self.model
+                .obs
+                .project_cached::<true>(cache, self.z, x[0], x[2])
+        } else {
+            self.model.obs.project(self.z, x[0], x[2])
+        };
         // Gate (eq. 10). r >= r_th  <=>  |<m, m^i>|^2 >= r_th^2 ||m||^2 ||m^i||^2 (no sqrt).
         let r_th = self.cfg.r_th;
         let num2 = (pr.zh + par_zh).norm_sqr();
@@ -646,13 +656,21 @@ fn risk_present(
     x: &[f32; 3],
     existed: bool,
     mut rng: Rng,
+    cache: &mut ProjectionCache,
 ) -> (Rng, f32) {
     let xp = if existed {
         model.motion.predict(*x)
     } else {
         model.prior.sample(&mut rng)
     };
-    let d2 = model.obs.project_re(z, xp[0], xp[2]).residual_norm2(zz);
+    // Births land anywhere in the band: projected directly (a cache entry would be used
+    // once).
+    let pr = if existed {
+        model.obs.project_cached::<false>(cache, z, xp[0], xp[2])
+    } else {
+        model.obs.project_re(z, xp[0], xp[2])
+    };
+    let d2 = pr.residual_norm2(zz);
     (rng, d2)
 }
 
@@ -671,6 +689,7 @@ fn risk_pass(
     out: &mut [f32],
     rng_out: &mut Rng,
     births: &Births,
+    cache: &mut ProjectionCache,
 ) -> f32 {
     let zz_floor = zz.max(f32::MIN_POSITIVE);
     let draw_table = ExistenceDraw::new(&model.chain);
@@ -691,6 +710,7 @@ fn risk_pass(
         rng,
         dmin: f32::INFINITY,
         n_present: 0,
+        cache,
     };
     let n = exists.len().min(out.len()).min(parts.len());
     // The loop itself handles only the common case, an absent particle that stays absent
@@ -726,10 +746,11 @@ struct RiskCtx<'a> {
 }
 
 /// What the risk pass accumulates out of line.
-struct RiskState {
+struct RiskState<'a> {
     rng: Rng,
     dmin: f32,
     n_present: usize,
+    cache: &'a mut ProjectionCache,
 }
 
 impl RiskCtx<'_> {
@@ -737,11 +758,11 @@ impl RiskCtx<'_> {
     /// (`left = 0`): its predicted existence, its residual (`||z||^2` floored if absent)
     /// and the new gap.
     #[inline(never)]
-    fn other(&self, st: &mut RiskState, e: bool, x: &[f32; 3], mut left: u32) -> (u32, f32) {
+    fn other(&self, st: &mut RiskState<'_>, e: bool, x: &[f32; 3], mut left: u32) -> (u32, f32) {
         let mut rng = st.rng.clone();
         let present = predicted_existence(self.draw, self.births, e, &mut rng, &mut left);
         let v = if present {
-            let (r, d2) = risk_present(self.model, self.z, self.zz, x, e, rng);
+            let (r, d2) = risk_present(self.model, self.z, self.zz, x, e, rng, st.cache);
             rng = r;
             st.n_present += 1;
             // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never
@@ -778,6 +799,8 @@ pub struct CrpfTbd<const N: usize> {
     int_exponent: Option<u32>,
     /// The birth-gap sampler of the model's existence chain.
     births: Births,
+    /// Per-frame projection sums.
+    cache: ProjectionCache,
 }
 
 impl<const N: usize> CrpfTbd<N> {
@@ -806,6 +829,7 @@ impl<const N: usize> CrpfTbd<N> {
             frame: 0,
             int_exponent,
             births,
+            cache: ProjectionCache::default(),
         };
         s.reset(seed);
         Ok(s)
@@ -875,6 +899,7 @@ impl<const N: usize> CrpfTbd<N> {
             &mut self.log_w,
             &mut self.rng,
             &self.births,
+            &mut self.cache,
         );
         if let Some(n) = self.int_exponent {
             // w_i = (min d2 / d2_i)^(q p / 2): eq. 4 normalised by its largest weight,
@@ -963,6 +988,7 @@ impl<const N: usize> CrpfTbd<N> {
     fn step_inner(&mut self, z: &[Complex32]) -> Result<TbdReport> {
         let m = self.model.obs.bins();
         let zz = check_frame(z, m)?;
+        self.cache.new_frame();
         let ln_lambda = if self.cfg.lambda > 0.0 {
             math::ln(self.cfg.lambda)
         } else {
@@ -995,6 +1021,7 @@ impl<const N: usize> CrpfTbd<N> {
             best: f32::INFINITY,
             arg: None,
             anc: &mut self.anc,
+            cache: &mut self.cache,
         };
         // With lambda = 0 an absent particle's state is never read again: only its flag
         // is written (and it is already `false`).
