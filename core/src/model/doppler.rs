@@ -23,7 +23,12 @@
 //! ||z - h||^2 = ||z||^2 - 2 Re <z, h> + ||h||^2,   <z, h> = sum_b conj(z_b) h_b
 //! ```
 //!
-//! over those five bins ([`DopplerModel::project`]).
+//! over those five bins ([`DopplerModel::project`]). Within one frame the five-bin sums
+//! of a table row are linear in the interpolation fraction `f`:
+//! `<z, h> / A = sum_j conj(z_j) a_j + f sum_j conj(z_j) d_j` (`a_j`, `d_j` the row's
+//! points and slopes) and `||h||^2 / A^2 = H0 + f (H1 + f H2)` (per row, computed once in
+//! `f64`), so [`DopplerModel::project_cached`] keeps the two complex sums per (first bin,
+//! row) in a [`ProjectionCache`] filled on first use in each frame.
 //!
 //! # Approximation error (stated bound, checked by `tests/crpf_model.rs`)
 //! Two sources: (1) the window's energy outside the five bins nearest the peak (the
