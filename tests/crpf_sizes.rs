@@ -2,7 +2,8 @@
 //! budget the docs state: CRPF-TBD 41 B/particle (28 B particle state + 1 B existence
 //! flag + 4 B log weight + 4 B weight + 4 B ancestor), PF-TBD 28 B (16 + 12), JOTT and PF-LRT 24 B (12 + 12), plus a
 //! fixed part under 11 KB (the response table as 128 interpolation rows of 5 bins x 4
-//! f32, 10 KB, and the previous frame).
+//! f32, 10 KB, and the previous frame) besides the tables of the cached projection
+//! (1.7 KB per model, and CRPF-TBD's 20 KB cache).
 
 use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::CrpfTbd;

@@ -319,9 +319,14 @@ impl DopplerModel {
         out
     }
 
-    /// [`project`](Self::project) through a per-frame cache of `A` and `D` (see
-    /// [`ProjectionCache`]): `<z, h> = A (A + frac D)`, `||h||^2 = A^2 (H0 + frac (H1 +
-    /// frac H2))`. The same values up to rounding. `IM = false`: `Im <z, h>` is 0.
+    /// [`project`](Self::project) through a per-frame cache of the row sums `A`, `D` (see
+    /// [`ProjectionCache`]): `<z, h> = amp (A + frac D)`, `||h||^2 = amp^2 (H0 + frac (H1 +
+    /// frac H2))`; the same values up to rounding (relative difference below 4e-6, test
+    /// `crpf_model`). `IM = false`: `Im <z, h>` is 0. The table position comes from
+    /// `U = 128 (fd ts m + 1/2 + m)`: `U >> 7` the nearest bin (plus `m`), `U & 127` the
+    /// row, `U - floor(U)` the fraction. Not finite or outside the band, or `m > 32`:
+    /// the direct [`project`](Self::project). `cache` must be valid for `z`:
+    /// [`ProjectionCache::new_frame`] once before a frame's first call (a new cache too).
     #[inline(always)]
     pub fn project_cached<const IM: bool>(
         &self,
@@ -434,13 +439,15 @@ impl DopplerModel {
 
 /// Entries of the [`ProjectionCache`] (direct-mapped on `(first bin mod 8, table row)`).
 const CACHE_LEN: usize = 1024;
-/// Frames before the cache's stamps wrap (the tag keeps 12 bits for the key
-/// `first * 128 + row`, `first < 32`; larger frames project directly).
+/// Keys `first * 128 + row` the cache holds (`first < 32`; the other first bins of
+/// larger frames project directly). An entry's tag is `frame * 4096 + key`.
 const CACHE_KEYS: u32 = 4096;
 
 /// Per-frame cache of the five-bin sums `A`, `D` of [`DopplerModel::project_cached`] for a
 /// (first bin, table row): direct-mapped, 1024 entries, each tagged with its key and the
-/// frame, filled on first use in a frame (20 KB).
+/// frame, filled on first use in a frame (20 KB). Call [`new_frame`](Self::new_frame)
+/// before the first projection of every frame (also of a new or zeroed cache: its
+/// frame stamp 0 is not valid).
 #[derive(Debug, Clone)]
 pub struct ProjectionCache {
     sums: [[f32; 4]; CACHE_LEN],
