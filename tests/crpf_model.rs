@@ -132,3 +132,51 @@ fn bad_configs_and_frames_are_errors() {
         Err(Error::Empty)
     );
 }
+
+#[test]
+fn cached_projection_matches_direct() {
+    // `project_cached` (CRPF-TBD's continuing particles) against `project`: the same
+    // sums regrouped (`A + frac D`, `||h||^2` as a quadratic in `frac`) and the table
+    // position from one scaled Doppler, so they differ by rounding and by the fraction's
+    // resolution (2^-11 of a table step, about 1e-5 of |h|): the tolerance 1e-4 of the
+    // scale sqrt(||z||^2 ||h||^2) (resp. of ||h||^2) is ten times that (measured worst:
+    // 2.6e-6, 1.9e-6, 3.8e-6 for m = 32, 16, 64; m = 64 mixes cached first bins < 32
+    // and direct ones). Several frames
+    // through one cache (each entry must be refilled after `new_frame`), Dopplers over
+    // the band and its edges (bins that wrap), amplitudes 0.05-1.5.
+    let mut rng = Rng::seed_from_u64(42);
+    for (m, ts) in [(32usize, 0.02f32), (16, 0.04), (64, 0.01)] {
+        let model = DopplerModel::new(m, ts, Window::Hamming).unwrap();
+        let half = 0.5 / ts;
+        let mut cache = ProjectionCache::default();
+        let mut worst = 0.0f32;
+        for _ in 0..20 {
+            cache.new_frame();
+            let z: Vec<Complex32> = (0..m)
+                .map(|_| Complex32::new(3.0 * rng.normal(), 3.0 * rng.normal()))
+                .collect();
+            let zz: f32 = z.iter().map(|c| c.norm_sqr()).sum();
+            for i in 0..2000 {
+                let fd = match i % 4 {
+                    0 => half * (1.0 - 1e-6 * rng.uniform()),
+                    1 => -half * (1.0 - 1e-3 * rng.uniform()),
+                    _ => rng.uniform_range(-half, half),
+                };
+                let amp = rng.uniform_range(0.05, 1.5);
+                let d = model.project(&z, fd, amp);
+                let c = model.project_cached::<true>(&mut cache, &z, fd, amp);
+                let r = model.project_cached::<false>(&mut cache, &z, fd, amp);
+                let scale = (zz * d.hh).sqrt();
+                let e = ((c.zh - d.zh).norm() / scale).max((c.hh - d.hh).abs() / d.hh);
+                assert!(e < 1e-4, "m {m} fd {fd} amp {amp}: {c:?} vs {d:?}");
+                assert_eq!((r.zh.re, r.zh.im, r.hh), (c.zh.re, 0.0, c.hh));
+                worst = worst.max(e);
+            }
+        }
+        println!("m = {m}: worst relative difference {worst:e}");
+        // Not finite: the direct path.
+        let z = vec![Complex32::new(1.0, 0.0); m];
+        let n = model.project_cached::<true>(&mut cache, &z, f32::NAN, 1.0);
+        assert_eq!(n, model.project(&z, f32::NAN, 1.0));
+    }
+}

@@ -23,7 +23,12 @@
 //! ||z - h||^2 = ||z||^2 - 2 Re <z, h> + ||h||^2,   <z, h> = sum_b conj(z_b) h_b
 //! ```
 //!
-//! over those five bins ([`DopplerModel::project`]).
+//! over those five bins ([`DopplerModel::project`]). Within one frame the five-bin sums
+//! of a table row are linear in the interpolation fraction `f`:
+//! `<z, h> / A = sum_j conj(z_j) a_j + f sum_j conj(z_j) d_j` (`a_j`, `d_j` the row's
+//! points and slopes) and `||h||^2 / A^2 = H0 + f (H1 + f H2)` (per row, computed once in
+//! `f64`), so [`DopplerModel::project_cached`] keeps the two complex sums per (first bin,
+//! row) in a [`ProjectionCache`] filled on first use in each frame.
 //!
 //! # Approximation error (stated bound, checked by `tests/crpf_model.rs`)
 //! Two sources: (1) the window's energy outside the five bins nearest the peak (the
@@ -124,12 +129,22 @@ impl Projection {
 #[derive(Debug, Clone)]
 pub struct DopplerModel {
     m: usize,
+    /// `m as f32` (converted once, not per particle).
+    m_f32: f32,
     ts: f32,
     window: Window,
     /// `rows[i0][j]`: the table points `t = i0 + (SPAN - 1 - j) S` and `t + 1` of bin `j`
     /// (`S` = [`TABLE_STEPS`]), so one fractional table position serves all five bins
     /// with one bounds check and no index arithmetic in the hot loop.
     rows: [Row; TABLE_STEPS],
+    /// `U = fd u_scale + u_off` is `128 (pos + 1/2 + m)` (`pos = fd ts m`): `U >> 7` is the
+    /// nearest bin plus `m`, `U & 127` the row, the rest the fraction.
+    u_scale: f32,
+    u_off: f32,
+    /// `first_of[q] = (q - m - J) mod m` for `q = U >> 7 < 2m`.
+    first_of: [u8; 2 * MAX_BINS],
+    /// `[H0, H1, H2]` of each row: `sum_j |a_j + f d_j|^2 = H0 + f (H1 + f H2)`.
+    hq: [[f32; 3]; TABLE_STEPS],
     window_sum: f32,
     window_energy: f32,
 }
@@ -160,6 +175,21 @@ impl DopplerModel {
                 *cell = [a.re, a.im, b.re - a.re, b.im - a.im];
             }
         }
+        let mut first_of = [0u8; 2 * MAX_BINS];
+        for (q, f) in first_of.iter_mut().enumerate() {
+            *f = (q as i64 - m as i64 - HALF_SPAN as i64).rem_euclid(m as i64) as u8;
+        }
+        let mut hq = [[0.0f32; 3]; TABLE_STEPS];
+        for (h, row) in hq.iter_mut().zip(rows.iter()) {
+            let (mut h0, mut h1, mut h2) = (0.0f64, 0.0f64, 0.0f64);
+            for c in row.iter() {
+                let (ar, ai, dr, di) = (c[0] as f64, c[1] as f64, c[2] as f64, c[3] as f64);
+                h0 += ar * ar + ai * ai;
+                h1 += 2.0 * (ar * dr + ai * di);
+                h2 += dr * dr + di * di;
+            }
+            *h = [h0 as f32, h1 as f32, h2 as f32];
+        }
         let mut s = 0.0f64;
         let mut s2 = 0.0f64;
         for n in 0..m {
@@ -169,9 +199,14 @@ impl DopplerModel {
         }
         Ok(Self {
             m,
+            m_f32: m as f32,
             ts,
             window,
             rows,
+            u_scale: (ts as f64 * m as f64 * TABLE_STEPS as f64) as f32,
+            u_off: (TABLE_STEPS / 2 + TABLE_STEPS * m) as f32,
+            first_of,
+            hq,
             window_sum: s as f32,
             window_energy: s2 as f32,
         })
@@ -218,7 +253,18 @@ impl DopplerModel {
     /// `b0 - J (mod m)`; returns `(first_bin, interpolation row, fraction)`.
     #[inline]
     fn locate(&self, fd: f32) -> (usize, &Row, f32) {
-        let pos = fd * self.ts * self.m as f32;
+        let (first, i0, frac) = self.locate_i(fd);
+        let row = match self.rows.get(i0) {
+            Some(r) => r,
+            None => &self.rows[0],
+        };
+        (first, row, frac)
+    }
+
+    /// [`locate`](Self::locate) with the row index.
+    #[inline(always)]
+    fn locate_i(&self, fd: f32) -> (usize, usize, f32) {
+        let pos = fd * self.ts * self.m_f32;
         let pos = if pos.is_finite() { pos } else { 0.0 };
         let (b, bi) = if pos > -LARGE && pos < LARGE {
             // libm's roundf, trunc(x + copysign(0.5 - eps/4, x)), inlined.
@@ -246,11 +292,85 @@ impl DopplerModel {
         if !(0..m).contains(&first) {
             first = (b as i64 - HALF_SPAN as i64).rem_euclid(m as i64) as i32;
         }
+        (first as usize, i0, frac)
+    }
+
+    /// `[Re A, Im A, Re D, Im D]`, `A = sum_j conj(z_{first+j}) a_j`, `D` the same with
+    /// `d_j = b_j - a_j`, over row `i0` (bins wrap mod `m`).
+    fn sums(&self, z: &[Complex32], first: usize, i0: usize) -> [f32; 4] {
         let row = match self.rows.get(i0) {
             Some(r) => r,
             None => &self.rows[0],
         };
-        (first as usize, row, frac)
+        let mut out = [0.0f32; 4];
+        let mut b = first;
+        for c in row.iter() {
+            if let Some(zb) = z.get(b) {
+                out[0] += zb.re * c[0] + zb.im * c[1];
+                out[1] += zb.re * c[1] - zb.im * c[0];
+                out[2] += zb.re * c[2] + zb.im * c[3];
+                out[3] += zb.re * c[3] - zb.im * c[2];
+            }
+            b += 1;
+            if b == self.m {
+                b = 0;
+            }
+        }
+        out
+    }
+
+    /// [`project`](Self::project) through a per-frame cache of the row sums `A`, `D` (see
+    /// [`ProjectionCache`]): `<z, h> = amp (A + frac D)`, `||h||^2 = amp^2 (H0 + frac (H1 +
+    /// frac H2))`; the same values up to rounding (relative difference below 4e-6, test
+    /// `crpf_model`). `IM = false`: `Im <z, h>` is 0. The table position comes from
+    /// `U = 128 (fd ts m + 1/2 + m)`: `U >> 7` the nearest bin (plus `m`), `U & 127` the
+    /// row, `U - floor(U)` the fraction. Not finite or outside the band, or `m > 32`:
+    /// the direct [`project`](Self::project). `cache` must be valid for `z`:
+    /// [`ProjectionCache::new_frame`] once before a frame's first call (a new cache too).
+    #[inline(always)]
+    pub fn project_cached<const IM: bool>(
+        &self,
+        cache: &mut ProjectionCache,
+        z: &[Complex32],
+        fd: f32,
+        amp: f32,
+    ) -> Projection {
+        let u = fd * self.u_scale + self.u_off;
+        // In the band, 0 <= U < 256 m; NaN and anything else go to the direct path.
+        if !(u >= 0.0 && u < self.u_off * 2.0) {
+            return self.project_direct::<IM>(z, fd, amp);
+        }
+        let iu = u as u32;
+        let frac = u - iu as f32;
+        let i0 = (iu as usize) & (TABLE_STEPS - 1);
+        let first = match self.first_of.get((iu >> 7) as usize) {
+            Some(&f) => f as usize,
+            None => return self.project_direct::<IM>(z, fd, amp),
+        };
+        let key = first * TABLE_STEPS + i0;
+        let slot = key & (CACHE_LEN - 1);
+        let tag = cache.cur * CACHE_KEYS + key as u32;
+        let (Some(e), Some(t), Some(h)) = (
+            cache.sums.get_mut(slot),
+            cache.tag.get_mut(slot),
+            self.hq.get(i0),
+        ) else {
+            return self.project_direct::<IM>(z, fd, amp);
+        };
+        if key >= CACHE_KEYS as usize {
+            return self.project_direct::<IM>(z, fd, amp);
+        }
+        if *t != tag {
+            *e = self.sums(z, first, i0);
+            *t = tag;
+        }
+        let zr = e[0] + frac * e[2];
+        let zi = if IM { e[1] + frac * e[3] } else { 0.0 };
+        let hh = h[0] + frac * (h[1] + frac * h[2]);
+        Projection {
+            zh: Complex32::new(zr * amp, zi * amp),
+            hh: hh * amp * amp,
+        }
     }
 
     /// The evaluated response: `out[j] = h_{first + j (mod m)}` for `j = 0..SPAN`;
@@ -278,6 +398,12 @@ impl DopplerModel {
     #[inline]
     pub fn project_re(&self, z: &[Complex32], fd: f32, amp: f32) -> Projection {
         self.project_impl::<false>(z, fd, amp)
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn project_direct<const IM: bool>(&self, z: &[Complex32], fd: f32, amp: f32) -> Projection {
+        self.project_impl::<IM>(z, fd, amp)
     }
 
     #[inline(always)]
@@ -311,14 +437,62 @@ impl DopplerModel {
     }
 }
 
+/// Entries of the [`ProjectionCache`] (direct-mapped on `(first bin mod 8, table row)`).
+const CACHE_LEN: usize = 1024;
+/// Keys `first * 128 + row` the cache holds (`first < 32`; the other first bins of
+/// larger frames project directly). An entry's tag is `frame * 4096 + key`.
+const CACHE_KEYS: u32 = 4096;
+
+/// Per-frame cache of the five-bin sums `A`, `D` of [`DopplerModel::project_cached`] for a
+/// (first bin, table row): direct-mapped, 1024 entries, each tagged with its key and the
+/// frame, filled on first use in a frame (20 KB). Call [`new_frame`](Self::new_frame)
+/// before the first projection of every frame (also of a new or zeroed cache: its
+/// frame stamp 0 is not valid).
+#[derive(Debug, Clone)]
+pub struct ProjectionCache {
+    sums: [[f32; 4]; CACHE_LEN],
+    /// `frame * 4096 + key` of each entry.
+    tag: [u32; CACHE_LEN],
+    /// Frame stamp (1-based; 0 marks empty entries).
+    cur: u32,
+}
+
+impl Default for ProjectionCache {
+    fn default() -> Self {
+        Self {
+            sums: [[0.0; 4]; CACHE_LEN],
+            tag: [0; CACHE_LEN],
+            cur: 0,
+        }
+    }
+}
+
+impl ProjectionCache {
+    /// Invalidates every entry (call once per new frame).
+    pub fn new_frame(&mut self) {
+        self.cur += 1;
+        if self.cur >= u32::MAX / CACHE_KEYS {
+            self.tag = [0; CACHE_LEN];
+            self.cur = 1;
+        }
+    }
+}
+
 /// `sum_b conj(z_b) h_b / A` and `sum_b |h_b|^2 / A^2` over one interpolation row:
 /// fixed-size arrays, fully unrolled, no bounds checks.
 #[inline(always)]
 fn kernel<const IM: bool>(row: &Row, zs: &[Complex32; SPAN], frac: f32) -> (f32, f32, f32) {
-    let mut zr = 0.0f32;
-    let mut zi = 0.0f32;
-    let mut hh = 0.0f32;
-    for (c, zb) in row.iter().zip(zs.iter()) {
+    // The sums start from the first bin's terms instead of 0.0 + them: the same values,
+    // except that a sum of signed zeros may keep its sign (-0.0 instead of +0.0), which
+    // no cost, gate or weight can tell apart (each is squared or added first).
+    let (c, zb) = (&row[0], &zs[0]);
+    let hr = c[0] + c[2] * frac;
+    let hi = c[1] + c[3] * frac;
+    let mut zr = zb.re * hr + zb.im * hi;
+    let mut zi = if IM { zb.re * hi - zb.im * hr } else { 0.0 };
+    let mut hh = hr * hr + hi * hi;
+    for j in 1..SPAN {
+        let (c, zb) = (&row[j], &zs[j]);
         let hr = c[0] + c[2] * frac;
         let hi = c[1] + c[3] * frac;
         // conj(z) h
