@@ -49,7 +49,13 @@ fn run() {
         .ok()
         .and_then(|r| r.parse().ok())
         .unwrap_or(3);
-    let sc = SixTargets::new(9.0);
+    let mut sc = SixTargets::new(9.0);
+    if let Some(cap) = std::env::var("FAINT_SWARM_CAP")
+        .ok()
+        .and_then(|c| c.parse::<usize>().ok())
+    {
+        sc.swarm_cap = cap;
+    }
     for v in Variant::ALL {
         let tag = match v {
             Variant::PhdTbd => "phd",
@@ -65,14 +71,6 @@ fn run() {
             let mut rng = Rng::seed_from_u64(70 + seed);
             let truth = sc.truth(&mut rng);
             let mut cfg = sc.config(v);
-            if let Some(cap) = std::env::var("FAINT_SWARM_CAP")
-                .ok()
-                .and_then(|c| c.parse::<usize>().ok())
-            {
-                if let Some(p) = cfg.pso.as_mut() {
-                    p.max_members = if cap == 0 { usize::MAX } else { cap };
-                }
-            }
             if force {
                 if let Some(p) = cfg.pso.as_mut() {
                     p.threshold = 2.0;

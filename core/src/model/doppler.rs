@@ -254,11 +254,16 @@ impl DopplerModel {
     #[inline]
     fn locate(&self, fd: f32) -> (usize, &Row, f32) {
         let (first, i0, frac) = self.locate_i(fd);
-        let row = match self.rows.get(i0) {
+        (first, self.row(i0), frac)
+    }
+
+    /// Interpolation row `i0` (`i0 < TABLE_STEPS` by construction; row 0 otherwise).
+    #[inline(always)]
+    fn row(&self, i0: usize) -> &Row {
+        match self.rows.get(i0) {
             Some(r) => r,
             None => &self.rows[0],
-        };
-        (first, row, frac)
+        }
     }
 
     /// [`locate`](Self::locate) with the row index.
@@ -298,10 +303,7 @@ impl DopplerModel {
     /// `[Re A, Im A, Re D, Im D]`, `A = sum_j conj(z_{first+j}) a_j`, `D` the same with
     /// `d_j = b_j - a_j`, over row `i0` (bins wrap mod `m`).
     fn sums(&self, z: &[Complex32], first: usize, i0: usize) -> [f32; 4] {
-        let row = match self.rows.get(i0) {
-            Some(r) => r,
-            None => &self.rows[0],
-        };
+        let row = self.row(i0);
         let mut out = [0.0f32; 4];
         let mut b = first;
         for c in row.iter() {

@@ -532,7 +532,8 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     /// A group with one active objective keeps its best half by that objective (its
     /// fronts are the distinct values and crowding adds nothing), with two the sort checks
     /// one member per front, so the selection is O(N log N) whatever the front sizes;
-    /// with three or more it is ENS-BS on the group. Only the front that is cut gets
+    /// with three or four the divide-and-conquer sort of [`ndsort`], with five or more
+    /// ENS-BS checking every front member. Only the front that is cut gets
     /// crowding distances (NSGA-II), since the fronts before it are kept whole.
     fn select(&mut self, tot: usize, m: usize, obj_w: f32) {
         // Counting sort of the entries by group into `order`.
@@ -627,7 +628,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             // divide-and-conquer's `log^(M-1) N` factor outgrows it at these group
             // sizes: measured -2 % to -5 % per frame, same selections).
             let (taken, cut_len) = if na == 2 || na > DC_OBJECTIVES {
-                self.fronts_two(s, e, keep, act)
+                self.fronts_ens(s, e, keep, act)
             } else {
                 self.fronts_many(s, e, keep, act)
             };
@@ -637,11 +638,12 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
         }
     }
 
-    /// Two active objectives: ENS-BS over the group's lexicographic order in
-    /// `order[s..e]`, checking one member per front (O(N log N)). Marks the fronts that
+    /// Two, or more than [`DC_OBJECTIVES`], active objectives: ENS-BS over the group's
+    /// lexicographic order in `order[s..e]`, checking one member per front with two
+    /// objectives (O(N log N)), every member with more. Marks the fronts that
     /// fit in `keep` and copies the members of the front that is cut to `head[s..]`;
     /// returns (kept, members of the cut front).
-    fn fronts_two(&mut self, s: usize, e: usize, keep: usize, act: &[usize]) -> (usize, usize) {
+    fn fronts_ens(&mut self, s: usize, e: usize, keep: usize, act: &[usize]) -> (usize, usize) {
         let fit = &self.fit;
         let fronts = ens_bs(
             &self.order[s..e],
@@ -696,7 +698,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     /// Three or four active objectives (at most [`DC_OBJECTIVES`]; more are not read):
     /// ranks by [`ndsort::rank_sorted`] on the objectives copied to `objs` (position
     /// ranks in `rank[s..e]`, workspaces `head`, `next`, `aux`, `crowd` over `s..e`), then
-    /// as [`Swarm::fronts_two`].
+    /// as [`Swarm::fronts_ens`].
     fn fronts_many(&mut self, s: usize, e: usize, keep: usize, act: &[usize]) -> (usize, usize) {
         let len = e - s;
         for (o, &i) in self.objs.iter_mut().zip(&self.order[s..e]) {

@@ -855,7 +855,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             }
             // `g >= j`: slot `j` of `order` is free once read.
             self.order[n_s] = i as u32;
-            before[k.min(M - 1)] += self.w[i];
+            before[k] += self.w[i];
             n_s += 1;
         }
         if n_s == 0 {
