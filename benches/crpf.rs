@@ -9,12 +9,17 @@ use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint::core::model::doppler::{estimate_noise_variance, FrameDetector};
+use faint::core::detect::Detector;
+use faint::core::model::doppler::{estimate_noise_variance, DopplerReport};
 use faint::core::rng::Rng;
+use faint::core::Complex32;
 use faint::host::scenario::othr::{Noise, Othr};
 use std::hint::black_box;
 
-fn run_all(d: &mut dyn FrameDetector, frames: &[Vec<faint::core::Complex32>]) -> f32 {
+fn run_all<D: Detector<Frame = [Complex32], Report = DopplerReport>>(
+    d: &mut D,
+    frames: &[Vec<Complex32>],
+) -> f32 {
     d.reset(7);
     let mut acc = 0.0;
     for z in frames {
@@ -27,21 +32,18 @@ fn bench_n<const N: usize>(c: &mut Criterion) {
     let run = Othr::default().simulate(Some(5.0), Noise::Gaussian, &mut Rng::seed_from_u64(1));
     let var = estimate_noise_variance(run.frames.iter().map(|f| f.as_slice()), 32).unwrap();
     let g = GaussConfig::othr(var);
-    let mut dets: Vec<(&str, Box<dyn FrameDetector>)> = vec![
-        (
-            "crpf_tbd",
-            Box::new(CrpfTbd::<N>::new(CrpfConfig::othr(), 1).unwrap()),
-        ),
-        ("pf_tbd", Box::new(PfTbd::<N>::new(g, 1).unwrap())),
-        ("jott", Box::new(BernoulliTbd::<N>::new(g, 1).unwrap())),
-        ("pf_lrt", Box::new(PfLrt::<N>::new(g, 1).unwrap())),
-    ];
     let mut group = c.benchmark_group(format!("othr_frame_n{N}"));
     group.throughput(Throughput::Elements(run.frames.len() as u64));
     group.sample_size(20);
-    for (name, d) in dets.iter_mut() {
-        group.bench_function(*name, |b| b.iter(|| run_all(d.as_mut(), &run.frames)));
-    }
+    let frames = &run.frames;
+    let mut crpf = Box::new(CrpfTbd::<N>::new(CrpfConfig::othr(), 1).unwrap());
+    group.bench_function("crpf_tbd", |b| b.iter(|| run_all(crpf.as_mut(), frames)));
+    let mut pf = Box::new(PfTbd::<N>::new(g, 1).unwrap());
+    group.bench_function("pf_tbd", |b| b.iter(|| run_all(pf.as_mut(), frames)));
+    let mut jott = Box::new(BernoulliTbd::<N>::new(g, 1).unwrap());
+    group.bench_function("jott", |b| b.iter(|| run_all(jott.as_mut(), frames)));
+    let mut lrt = Box::new(PfLrt::<N>::new(g, 1).unwrap());
+    group.bench_function("pf_lrt", |b| b.iter(|| run_all(lrt.as_mut(), frames)));
     group.finish();
 }
 

@@ -11,6 +11,7 @@
 //! the plots that belong to targets and to other confirmed tracks, and the peak cell's
 //! count without the plots it shares with the other confirmed tracks; `noresid` turns the detector's
 //! residual rule (`MhtConfig::residual`) off.
+use faint_core::detect::Detector;
 use faint_core::rng::Rng;
 use faint_host::analysis::hough_model::{CellModel, ChainSource, CompoundModel};
 use faint_host::reproduce::mht::{detectors, model_params, thresholds, MATCH_TOL, NR, NT};
@@ -40,7 +41,7 @@ fn false_tracks(a: &[String]) {
         };
         let mut cfg = *m.config();
         cfg.residual = !no_resid;
-        if m.configure(cfg).is_err() {
+        if m.configure(&cfg, 0).is_err() {
             return;
         }
         for s in &tr.scans {
@@ -162,7 +163,7 @@ fn lost_targets(a: &[String]) {
         };
         let mut cfg = *off.config();
         cfg.residual = false;
-        if off.configure(cfg).is_err() {
+        if off.configure(&cfg, 0).is_err() {
             return;
         }
         let (mut d_off, mut d_on) = (None, None);

@@ -1,6 +1,7 @@
 //! Per-frame diagnostics of the PHD-TBD filter on one seed of the six-targets preset:
 //! per true target the particle mass and count within 40 m, the log likelihood ratio at
 //! the true state, total mass and N_hat. `cargo run --release --example phd_diag -- SNR SEED VARIANT LAMBDA`
+use faint_core::detect::Detector;
 use faint_core::model::power_cube::{PowerCube, RadarCoords};
 use faint_core::rng::Rng;
 use faint_host::scenario::six_targets::{HostFilter, SixTargets, Variant};

@@ -10,6 +10,7 @@
 //! swarm (`PsoConfig::max_members`; 0 = all gated particles; default the preset's 512). `FAINT_RUNS=1` measures the first run only (for
 //! instruction profiles under callgrind). CPU time is the thread's, so time spent waiting for a
 //! core on a loaded machine is not counted (Linux x86_64 / aarch64 only).
+use faint_core::detect::Detector;
 use faint_core::rng::Rng;
 use faint_host::scenario::six_targets::{HostFilter, SixTargets, Variant};
 

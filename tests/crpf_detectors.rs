@@ -5,7 +5,8 @@ use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::{CrpfConfig, CrpfTbd, Weighting};
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint::core::model::doppler::{estimate_noise_variance, FrameDetector, TbdReport};
+use faint::core::detect::Detector;
+use faint::core::model::doppler::{estimate_noise_variance, DopplerReport};
 use faint::core::rng::Rng;
 use faint::core::statistic::zeta_k;
 use faint::core::{Complex32, Error};
@@ -14,7 +15,23 @@ use faint::host::scenario::othr::{Noise, Othr, Run};
 
 const N: usize = 1000;
 
-fn detectors(var: f32, seed: u64) -> Vec<(&'static str, Box<dyn FrameDetector>)> {
+/// The four detectors behind one object type (their configs differ, so they do not
+/// share a `dyn Detector`).
+trait Doppler {
+    fn step(&mut self, z: &[Complex32]) -> Result<DopplerReport, Error>;
+    fn run(&mut self, run: &Run) -> Vec<DopplerReport>;
+}
+
+impl<D: Detector<Frame = [Complex32], Report = DopplerReport>> Doppler for D {
+    fn step(&mut self, z: &[Complex32]) -> Result<DopplerReport, Error> {
+        Detector::step(self, z)
+    }
+    fn run(&mut self, run: &Run) -> Vec<DopplerReport> {
+        run_detector(self, run).unwrap()
+    }
+}
+
+fn detectors(var: f32, seed: u64) -> Vec<(&'static str, Box<dyn Doppler>)> {
     let g = GaussConfig::othr(var);
     vec![
         (
@@ -31,7 +48,7 @@ fn var_of(run: &Run) -> f32 {
     estimate_noise_variance(run.frames.iter().map(|f| f.as_slice()), 32).unwrap()
 }
 
-fn mean(r: &[TbdReport], frames: std::ops::RangeInclusive<usize>) -> f32 {
+fn mean(r: &[DopplerReport], frames: std::ops::RangeInclusive<usize>) -> f32 {
     let v: Vec<f32> = frames.map(|k| r[k - 1].existence).collect();
     v.iter().sum::<f32>() / v.len() as f32
 }
@@ -52,7 +69,7 @@ fn existence_rises_with_the_target_and_falls_after_at_15_db() {
         let run = sc.simulate(Some(15.0), noise, &mut Rng::seed_from_u64(seed));
         let before_var = var_of(&run);
         for (name, mut d) in detectors(before_var, seed + 100) {
-            let r = run_detector(d.as_mut(), &run).unwrap();
+            let r = d.run(&run);
             assert!(r
                 .iter()
                 .all(|x| x.existence.is_finite() && x.log_lr.is_finite()));
@@ -121,7 +138,7 @@ fn doppler_estimate_error_at_15_db() {
         );
         let var = var_of(&run);
         for (i, (_, mut d)) in detectors(var, seed).into_iter().enumerate() {
-            let r = run_detector(d.as_mut(), &run).unwrap();
+            let r = d.run(&run);
             for k in 14..=26 {
                 let t = run.truth[k - 1].unwrap()[0];
                 let mut est = vec![(i, r[k - 1].estimate)];

@@ -12,7 +12,8 @@ use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::{CrpfConfig, CrpfTbd, Weighting};
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint::core::model::doppler::{DopplerModel, FrameDetector, TbdReport, Window};
+use faint::core::detect::Detector;
+use faint::core::model::doppler::{DopplerModel, DopplerReport, Window};
 use faint::core::rng::Rng;
 use faint::core::Complex32;
 
@@ -45,7 +46,7 @@ fn frames() -> Vec<[Complex32; 32]> {
         .collect()
 }
 
-fn run(d: &mut dyn FrameDetector) -> Vec<TbdReport> {
+fn run<D: Detector<Frame = [Complex32], Report = DopplerReport>>(d: &mut D) -> Vec<DopplerReport> {
     frames().iter().map(|z| d.step(z).unwrap()).collect()
 }
 
@@ -56,7 +57,7 @@ fn reconfigure_equals_new() {
     let want = run(&mut CrpfTbd::<N>::new(cfg, seed).unwrap());
     // From zero.
     let mut z = Box::new(ZERO_CRPF);
-    z.reconfigure(cfg, seed).unwrap();
+    z.configure(&cfg, seed).unwrap();
     assert_eq!(run(&mut *z), want);
     // From a detector with another config, mid-run.
     let other = CrpfConfig {
@@ -66,33 +67,33 @@ fn reconfigure_equals_new() {
     };
     let mut d = CrpfTbd::<N>::new(other, 5).unwrap();
     let _ = run(&mut d);
-    d.reconfigure(cfg, seed).unwrap();
+    d.configure(&cfg, seed).unwrap();
     assert_eq!(run(&mut d), want);
     // A bad config is rejected and leaves the detector as it was.
     let before = d.clone();
     let bad = CrpfConfig { p: -1.0, ..cfg };
-    assert!(d.reconfigure(bad, 1).is_err());
+    assert!(d.configure(&bad, 1).is_err());
     assert_eq!(d.config(), before.config());
     assert_eq!(d.frame(), before.frame());
 
     let g = GaussConfig::othr(12.7);
     let want = run(&mut PfTbd::<N>::new(g, seed).unwrap());
     let mut z = Box::new(ZERO_PF);
-    z.reconfigure(g, seed).unwrap();
+    z.configure(&g, seed).unwrap();
     assert_eq!(run(&mut *z), want);
 
     let want = run(&mut BernoulliTbd::<N>::new(g, seed).unwrap());
     let mut z = Box::new(ZERO_JOTT);
-    z.reconfigure(g, seed).unwrap();
+    z.configure(&g, seed).unwrap();
     assert_eq!(run(&mut *z), want);
 
     let want = run(&mut PfLrt::<N>::new(g, seed).unwrap());
     let mut z = Box::new(ZERO_LRT);
-    z.reconfigure(g, seed).unwrap();
+    z.configure(&g, seed).unwrap();
     assert_eq!(run(&mut *z), want);
     let bad = GaussConfig {
         noise_var: 0.0,
         ..g
     };
-    assert!(z.reconfigure(bad, 1).is_err());
+    assert!(z.configure(&bad, 1).is_err());
 }

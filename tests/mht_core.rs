@@ -3,8 +3,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use faint::core::detect::hough::{
-    ClassicConfig, ClassicHough, Geometry, MhtConfig, MhtTbd, NO_PLOT,
+    ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, NO_PLOT,
 };
+use faint::core::detect::Detector;
 use faint::core::model::plot::Plot;
 use faint::core::rng::Rng;
 use faint::core::Error;
@@ -166,7 +167,7 @@ fn clean_target_is_detected_with_its_plots() {
 
 #[test]
 fn classic_detects_a_line_and_reports_each_period() {
-    let cfg = ClassicConfig {
+    let cfg = ClassicHoughConfig {
         area: [0.0, 1500.0, 0.0, 1500.0],
         n_scans: 10,
         gamma: 9,

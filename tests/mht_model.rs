@@ -2,6 +2,7 @@
 //! probabilities, and the model threshold applied in simulation.
 #![allow(clippy::needless_range_loop)]
 
+use faint::core::detect::Detector;
 use faint::core::rng::Rng;
 use faint::host::analysis::hough_model::{
     self, coverage_pmf, lattice_measure, run_value, run_value_pmf, run_value_pmf_brute, CellModel,
@@ -331,7 +332,7 @@ fn residual_rule_removes_target_induced_false_tracks() {
         let (mut m, mut c) = detectors(&sc, 11, 31).unwrap();
         let mut cfg = *m.config();
         cfg.residual = residual;
-        m.configure(cfg).unwrap();
+        m.configure(&cfg, 0).unwrap();
         for t in 0..trials {
             let mut rng = Rng::from_stream(9164, t);
             let tr = sc.generate(&mut rng);

@@ -2,6 +2,7 @@
 //! capacities, no-target behaviour, determinism.
 
 use faint::core::detect::phd::{PsoConfig, SmcPhdTbd};
+use faint::core::detect::Detector;
 use faint::core::rng::Rng;
 use faint::core::Error;
 use faint::host::scenario::six_targets::{HostFilter, SixTargets, Variant};
@@ -86,11 +87,11 @@ fn invalid_configurations_are_typed_errors() {
             Error::InvalidConfig("pso")
         );
         for bad in [
-            |c: &mut faint::core::detect::phd::Config| c.noise_var = 0.0,
-            |c: &mut faint::core::detect::phd::Config| c.p_survival = 1.5,
-            |c: &mut faint::core::detect::phd::Config| c.clutter_lambda = f32::NAN,
-            |c: &mut faint::core::detect::phd::Config| c.geometry.n_doppler = 0,
-            |c: &mut faint::core::detect::phd::Config| c.birth.n_components = 0,
+            |c: &mut faint::core::detect::phd::PhdConfig| c.noise_var = 0.0,
+            |c: &mut faint::core::detect::phd::PhdConfig| c.p_survival = 1.5,
+            |c: &mut faint::core::detect::phd::PhdConfig| c.clutter_lambda = f32::NAN,
+            |c: &mut faint::core::detect::phd::PhdConfig| c.geometry.n_doppler = 0,
+            |c: &mut faint::core::detect::phd::PhdConfig| c.birth.n_components = 0,
         ] {
             let mut c = sc.config(Variant::PhdTbd);
             bad(&mut c);

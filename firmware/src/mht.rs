@@ -5,6 +5,7 @@
 //! fixed seed before each measured step (not measured).
 
 use core::mem::size_of;
+use faint_core::detect::Detector;
 
 use faint_core::detect::hough::{MhtConfig, MhtTbd};
 use faint_core::model::plot::Plot;
@@ -61,7 +62,7 @@ pub fn run() {
     let buf = SCAN.take();
     let mut cfg = MhtConfig::sea_clutter();
     cfg.gamma1 = 22;
-    check(det.configure(cfg));
+    check(det.configure(&cfg, 0));
     let mut rng = Rng::from_stream(SEED, 0);
     let ram = size_of::<Det>() + size_of::<[Plot; P]>();
     let mut worst = Measurement {

@@ -16,9 +16,10 @@
 use core::hint::black_box;
 use core::mem::{size_of, MaybeUninit};
 use core::ptr::{read_volatile, write_volatile};
+use faint_core::detect::Detector;
 
 use cortex_m_semihosting::hprintln;
-use faint_core::detect::phd::{Config, SmcPhdTbd};
+use faint_core::detect::phd::{PhdConfig, SmcPhdTbd};
 use faint_core::rng::Rng;
 use faint_golden::phd::{config, cube, Variant, FIRMWARE_WINDOW, FRAMES};
 
@@ -62,8 +63,8 @@ pub fn run() {
 }
 
 /// Runs `frames` frames of the scene with `cfg` from a restart, measuring every `step`.
-fn variant(det: &mut Det, buf: &mut [f32; CELLS], name: &str, cfg: Config, frames: usize) {
-    check(det.reconfigure(cfg, SEED));
+fn variant(det: &mut Det, buf: &mut [f32; CELLS], name: &str, cfg: PhdConfig, frames: usize) {
+    check(det.configure(&cfg, SEED));
     let mut rng = Rng::from_stream(SEED, 1);
     let mut sum = 0u64;
     let mut parts = 0u32;

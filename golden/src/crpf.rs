@@ -6,8 +6,9 @@ use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint_core::detect::Detector;
 use faint_core::math;
-use faint_core::model::doppler::{DopplerModel, FrameDetector, Window, SPAN};
+use faint_core::model::doppler::{DopplerModel, DopplerReport, Window, SPAN};
 use faint_core::rng::Rng;
 use faint_core::Complex32;
 
@@ -54,7 +55,10 @@ pub fn target(k: usize) -> (f32, f32) {
     }
 }
 
-fn run(det: &mut dyn FrameDetector, model: &DopplerModel) -> [u32; 3] {
+fn run<D: Detector<Frame = [Complex32], Report = DopplerReport>>(
+    det: &mut D,
+    model: &DopplerModel,
+) -> [u32; 3] {
     let mut rng = Rng::from_stream(SEED, 300);
     let mut z = [Complex32::new(0.0, 0.0); 32];
     let mut fold_e = Fold::new();

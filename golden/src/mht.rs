@@ -3,7 +3,8 @@
 //! detector's peaks on the same scans. Stack use ~14 KiB (the detector lives on the stack).
 
 use crate::{Fold, ERR, SEED};
-use faint_core::detect::hough::{ClassicConfig, ClassicHough, MhtConfig, MhtTbd};
+use faint_core::detect::hough::{ClassicHough, ClassicHoughConfig, MhtConfig, MhtTbd};
+use faint_core::detect::Detector;
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
 
@@ -35,12 +36,12 @@ pub(crate) fn cases(emit: &mut dyn FnMut(&str, &[u32])) {
     cfg.n_scans = 10;
     cfg.gamma1 = 6;
     let mut det = Det::unconfigured();
-    let ccfg = ClassicConfig {
+    let ccfg = ClassicHoughConfig {
         area: cfg.area,
         n_scans: 10,
         gamma: 8,
     };
-    let (Ok(()), Ok(mut classic)) = (det.configure(cfg), ClassicHough::<32, 30, 4>::new(ccfg))
+    let (Ok(()), Ok(mut classic)) = (det.configure(&cfg, 0), ClassicHough::<32, 30, 4>::new(ccfg))
     else {
         emit("mht.detection", &[ERR]);
         return;

@@ -20,9 +20,10 @@
 //! stack: stack use is about 70 KiB (filter ~50 KiB, cube 16 KiB).
 
 use faint_core::detect::phd::{
-    BirthComponent, BirthMode, BirthModel, Config, DbscanParams, Extractor, PsoConfig, SmcPhdTbd,
-    MAX_BIRTH_COMPONENTS,
+    BirthComponent, BirthMode, BirthModel, DbscanParams, Extractor, PhdConfig, PsoConfig,
+    SmcPhdTbd, MAX_BIRTH_COMPONENTS,
 };
+use faint_core::detect::Detector;
 use faint_core::math;
 use faint_core::model::power_cube::{CubeGeometry, PointSpread, RadarCoords};
 use faint_core::rng::Rng;
@@ -159,7 +160,7 @@ pub fn config(
     particles_per_target: usize,
     births: usize,
     points: usize,
-) -> Config {
+) -> PhdConfig {
     let p = power();
     let mut components = [BirthComponent {
         mean: [0.0; 4],
@@ -168,7 +169,7 @@ pub fn config(
     for (c, b) in components.iter_mut().zip(BIRTHS) {
         c.mean = [b[0], 0.0, b[1], 0.0];
     }
-    Config {
+    PhdConfig {
         geometry: g,
         psf: PSF,
         noise_var: NOISE_VAR,

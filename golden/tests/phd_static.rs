@@ -5,13 +5,14 @@
 //! counts are those of a working filter.
 //!
 //! The all-zero value is a `const` item: the compiler's const evaluator checks that the
-//! zero bit pattern is a valid value of every field (the `Config`'s enums and `Option`,
+//! zero bit pattern is a valid value of every field (the `PhdConfig`'s enums and `Option`,
 //! `bool`, the generator's state), so a type change that made zeroing unsound would fail
 //! to compile here and on the firmware.
 
+use faint_core::detect::Detector;
 use std::mem::MaybeUninit;
 
-use faint_core::detect::phd::{Config, Report, SmcPhdTbd};
+use faint_core::detect::phd::{PhdConfig, PhdReport, SmcPhdTbd};
 use faint_golden::phd::{config, cube, truth, Variant, FIRMWARE_WINDOW, FRAMES, GOLDEN_WINDOW};
 use faint_golden::SEED;
 
@@ -26,7 +27,7 @@ type Firmware = SmcPhdTbd<6144, 1024, 8, 8>;
 const ZERO: Small = unsafe { MaybeUninit::zeroed().assume_init() };
 
 /// Per frame: the report, the estimates and the particles (all bits).
-type Trace = Vec<(Report, Vec<[u32; 6]>, Vec<[u32; 6]>)>;
+type Trace = Vec<(PhdReport, Vec<[u32; 6]>, Vec<[u32; 6]>)>;
 
 fn frames(g: &CubeGeometry) -> Vec<Vec<f32>> {
     let mut rng = Rng::from_stream(SEED, 501);
@@ -66,7 +67,7 @@ fn run<const N: usize, const S: usize, const M: usize, const K: usize>(
         .collect()
 }
 
-fn cfg(v: Variant) -> Config {
+fn cfg(v: Variant) -> PhdConfig {
     config(GOLDEN_WINDOW, v, 60, 64, 4)
 }
 
@@ -81,26 +82,26 @@ fn reconfigure_equals_new() {
         );
         // From zero.
         let mut z = Box::new(ZERO);
-        z.reconfigure(cfg(v), 7).unwrap();
+        z.configure(&cfg(v), 7).unwrap();
         assert_eq!(run(&mut *z, &cubes), want, "{v:?} from zero");
         // From a filter of another variant (other extractor, with or without the swarm),
         // mid-run.
         let other = Variant::ALL[(v as usize + 1) % 3];
         let mut d = Box::new(Small::new(cfg(other), 3).unwrap());
         let _ = run(&mut *d, &cubes[..6]);
-        d.reconfigure(cfg(v), 7).unwrap();
+        d.configure(&cfg(v), 7).unwrap();
         assert_eq!(d.measurement_points(), &[] as &[[f32; 2]]);
         assert_eq!(run(&mut *d, &cubes), want, "{v:?} after {other:?}");
         // A bad config is rejected and leaves the filter as it was.
         let before = d.clone();
-        let bad = Config {
+        let bad = PhdConfig {
             noise_var: -1.0,
             ..cfg(v)
         };
-        assert!(d.reconfigure(bad, 1).is_err());
+        assert!(d.configure(&bad, 1).is_err());
         let mut too_many_births = cfg(v);
         too_many_births.birth.particles = 256;
-        assert!(d.reconfigure(too_many_births, 1).is_err());
+        assert!(d.configure(&too_many_births, 1).is_err());
         assert_eq!(d.config(), before.config());
         assert_eq!(d.particles(), before.particles());
         assert_eq!(d.estimates(), before.estimates());

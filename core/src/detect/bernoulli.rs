@@ -14,9 +14,9 @@
 //! Noise assumed complex Gaussian, independent bins, variance `s2` (see
 //! [`GaussConfig`](super::pf_tbd::GaussConfig)).
 
-use super::gauss_cloud::{gauss_detector_constructors, GaussianCloud};
+use super::gauss_cloud::{gauss_detector, GaussianCloud};
 use crate::math;
-use crate::model::doppler::{FrameDetector, TbdReport};
+use crate::model::doppler::DopplerReport;
 use crate::{Complex32, Result};
 
 /// Bernoulli (JOTT) filter with `N` particles.
@@ -26,15 +26,15 @@ pub struct BernoulliTbd<const N: usize> {
     q: f32,
 }
 
-gauss_detector_constructors!(
+gauss_detector!(
     BernoulliTbd { q: 0.0 },
-    "Validates `cfg`; `q_0 = initial_existence`, particles from `U(I_x0)`."
+    "Validates `cfg`; `q_0 = initial_existence`, particles from `U(I_x0)`.",
+    crate::detect::ScoreKind::Existence
 );
 
-impl<const N: usize> FrameDetector for BernoulliTbd<N> {
-    /// One frame; errors as [`check_frame`](crate::model::doppler::check_frame) (state
-    /// untouched).
-    fn step(&mut self, z: &[Complex32]) -> Result<TbdReport> {
+impl<const N: usize> BernoulliTbd<N> {
+    /// One frame (the `Detector::step` of this detector).
+    fn advance(&mut self, z: &[Complex32]) -> Result<DopplerReport> {
         let chain = &self.cloud.model().chain;
         let q_pred = chain.predict(self.q);
         let born_mass = chain.birth() * (1.0 - self.q);
@@ -74,7 +74,8 @@ impl<const N: usize> FrameDetector for BernoulliTbd<N> {
         Ok(self.cloud.finish(self.q, 0.0))
     }
 
-    fn reset(&mut self, seed: u64) {
+    /// Restarts from frame 0 (the `Detector::reset` of this detector).
+    fn restart(&mut self, seed: u64) {
         self.q = self.cloud.model().initial_existence;
         self.cloud.reset(seed, |m, rng| m.prior.sample(rng));
     }

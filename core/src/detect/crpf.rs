@@ -59,11 +59,12 @@
 //! bytes of weights and ancestors and a 33 KB fixed part, the response table (11.7 KB)
 //! and the projection cache (20 KB) (about 279 KB at `N = 6000`): build
 //! large instances in a `Box`, or zeroed in a `static` and set up by
-//! [`CrpfTbd::reconfigure`].
+//! [`Detector::configure`](crate::detect::Detector::configure).
 
+use crate::detect::{Detection, Detector, ScoreKind, Validate};
 use crate::math::{self, KahanSum};
 use crate::model::doppler::{
-    check_frame, FrameDetector, Model, ModelConfig, ProjectionCache, TbdReport, MAX_BINS,
+    check_frame, DopplerReport, Model, ModelConfig, ProjectionCache, DOPPLER_STATE, MAX_BINS,
 };
 use crate::particles::{resample, Scheme};
 use crate::rng::Rng;
@@ -71,6 +72,11 @@ use crate::{Complex32, Error, Result};
 
 /// Resampling weight function `phi(R)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub enum Weighting {
     /// `phi(R) = R^-q` (eq. 4, the paper's choice).
     Power,
@@ -83,6 +89,11 @@ pub enum Weighting {
 
 /// Runtime values of CRPF-TBD.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct CrpfConfig {
     /// The shared OTHR model (observation, motion, existence chain, birth box). CRPF-TBD
     /// uses its motion `F` but not its process-noise levels.
@@ -117,8 +128,8 @@ impl CrpfConfig {
         }
     }
 
-    /// Checks every value; builds the model.
-    pub fn validate(&self) -> Result<Model> {
+    /// Checks every value and builds the model.
+    pub(crate) fn build(&self) -> Result<Model> {
         if !(self.p.is_finite() && self.p > 0.0) {
             return Err(Error::InvalidConfig("cost exponent p"));
         }
@@ -144,6 +155,12 @@ impl CrpfConfig {
             return Err(Error::InvalidConfig("jitter std"));
         }
         self.model.build()
+    }
+}
+
+impl Validate for CrpfConfig {
+    fn validate(&self) -> Result<()> {
+        self.build().map(|_| ())
     }
 }
 
@@ -808,6 +825,8 @@ pub struct CrpfTbd<const N: usize> {
     births: Births,
     /// Per-frame projection sums.
     cache: ProjectionCache,
+    /// The last frame's report.
+    last: DopplerReport,
 }
 
 impl<const N: usize> CrpfTbd<N> {
@@ -819,7 +838,7 @@ impl<const N: usize> CrpfTbd<N> {
         if u32::try_from(N).is_err() {
             return Err(Error::IndexOutOfRange);
         }
-        let model = cfg.validate()?;
+        let model = cfg.build()?;
         let int_exponent = int_exponent(&cfg);
         let births = Births::new(&model.chain);
         let mut s = Self {
@@ -837,33 +856,16 @@ impl<const N: usize> CrpfTbd<N> {
             int_exponent,
             births,
             cache: ProjectionCache::default(),
+            last: DopplerReport::default(),
         };
-        s.reset(seed);
+        s.init_from(seed);
         Ok(s)
     }
 
-    /// Re-validates `cfg` and restarts in place from `seed` (as [`new`](Self::new) would),
-    /// without building a detector by value: how one that lives in a `static` (e.g. the
-    /// firmware's zero-initialised ones) is set up. On error `self` is unchanged.
-    pub fn reconfigure(&mut self, cfg: CrpfConfig, seed: u64) -> Result<()> {
-        if N == 0 {
-            return Err(Error::InvalidConfig("particle count N = 0"));
-        }
-        if u32::try_from(N).is_err() {
-            return Err(Error::IndexOutOfRange);
-        }
-        let model = cfg.validate()?;
-        self.int_exponent = int_exponent(&cfg);
-        self.births = Births::new(&model.chain);
-        self.cfg = cfg;
-        self.model = model;
-        self.reset(seed);
-        Ok(())
-    }
-
-    /// The configuration.
-    pub fn config(&self) -> &CrpfConfig {
-        &self.cfg
+    fn init_from(&mut self, seed: u64) {
+        self.rng = Rng::seed_from_u64(seed);
+        self.last = DopplerReport::default();
+        self.init();
     }
 
     /// Frames processed since the last reset.
@@ -992,7 +994,7 @@ impl<const N: usize> CrpfTbd<N> {
         }
     }
 
-    fn step_inner(&mut self, z: &[Complex32]) -> Result<TbdReport> {
+    fn step_inner(&mut self, z: &[Complex32]) -> Result<DopplerReport> {
         let m = self.model.obs.bins();
         let zz = check_frame(z, m)?;
         self.cache.new_frame();
@@ -1044,7 +1046,7 @@ impl<const N: usize> CrpfTbd<N> {
         self.prev[..m].copy_from_slice(z);
         self.prev_zz = zz;
         self.frame += 1;
-        Ok(TbdReport {
+        Ok(DopplerReport {
             frame: self.frame,
             existence: count as f32 / N as f32,
             log_lr: 0.0,
@@ -1120,16 +1122,58 @@ impl<const N: usize> CrpfTbd<N> {
     }
 }
 
-impl<const N: usize> FrameDetector for CrpfTbd<N> {
-    /// One frame. Errors (state untouched): [`Error::LengthMismatch`] for a frame that is
-    /// not `m` bins, [`Error::NonFinite`] for NaN/inf samples.
-    fn step(&mut self, frame: &[Complex32]) -> Result<TbdReport> {
-        self.step_inner(frame)
+impl<const N: usize> Detector for CrpfTbd<N> {
+    type Frame = [Complex32];
+    type Config = CrpfConfig;
+    type Report = DopplerReport;
+    const STATE: &'static [&'static str] = DOPPLER_STATE;
+    const SCORE: ScoreKind = ScoreKind::Existence;
+
+    /// Re-validates `cfg` and restarts in place from `seed` (as [`CrpfTbd::new`] would),
+    /// without building a detector by value: how one that lives in a `static` (e.g. the
+    /// firmware's zero-initialised ones) is set up. On error `self` is unchanged.
+    fn configure(&mut self, cfg: &CrpfConfig, seed: u64) -> Result<()> {
+        if N == 0 {
+            return Err(Error::InvalidConfig("particle count N = 0"));
+        }
+        if u32::try_from(N).is_err() {
+            return Err(Error::IndexOutOfRange);
+        }
+        let model = cfg.build()?;
+        self.int_exponent = int_exponent(cfg);
+        self.births = Births::new(&model.chain);
+        self.cfg = *cfg;
+        self.model = model;
+        self.init_from(seed);
+        Ok(())
+    }
+
+    fn config(&self) -> &CrpfConfig {
+        &self.cfg
     }
 
     fn reset(&mut self, seed: u64) {
-        self.rng = Rng::seed_from_u64(seed);
-        self.init();
+        self.init_from(seed);
+    }
+
+    /// One frame. Errors (state untouched): [`Error::LengthMismatch`] for a frame that is
+    /// not `m` bins, [`Error::NonFinite`] for NaN/inf samples.
+    fn step(&mut self, frame: &[Complex32]) -> Result<DopplerReport> {
+        self.step_inner(frame)
+    }
+
+    /// One detection per frame with an estimate: the mean-cost `[fd, fda, A]`, scored by
+    /// the existence probability `P_E^k` (eq. 12).
+    fn detection_count(&self) -> usize {
+        usize::from(self.last.estimate.is_some())
+    }
+
+    fn detection(&self, i: usize) -> Option<Detection> {
+        if i == 0 {
+            self.last.detection(Self::SCORE)
+        } else {
+            None
+        }
     }
 }
 

@@ -12,14 +12,20 @@
 //! ```
 //! Noise model: independent complex Gaussian bins of variance `s2` ([`GaussConfig`]).
 
+use crate::detect::Validate;
 use crate::math;
-use crate::model::doppler::{check_frame, Model, ModelConfig, TbdReport};
+use crate::model::doppler::{check_frame, DopplerReport, Model, ModelConfig};
 use crate::particles::{gather_in_place, resample, Scheme};
 use crate::rng::Rng;
 use crate::{Complex32, Error, Result};
 
 /// Runtime values shared by the Gaussian comparators (PF-TBD, JOTT, PF-LRT).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct GaussConfig {
     /// The shared OTHR model; the process noise is used as given.
     pub model: ModelConfig,
@@ -36,8 +42,8 @@ impl GaussConfig {
         }
     }
 
-    /// Checks the variance; builds the model.
-    pub fn validate(&self) -> Result<Model> {
+    /// Checks the variance and builds the model.
+    pub(crate) fn build(&self) -> Result<Model> {
         check_variance(self.noise_var)?;
         self.model.build()
     }
@@ -48,8 +54,14 @@ impl GaussConfig {
         if N == 0 {
             return Err(Error::InvalidConfig("particle count N = 0"));
         }
-        let model = self.validate()?;
+        let model = self.build()?;
         Ok((model, 1.0 / self.noise_var))
+    }
+}
+
+impl Validate for GaussConfig {
+    fn validate(&self) -> Result<()> {
+        self.build().map(|_| ())
     }
 }
 
@@ -139,6 +151,7 @@ pub(crate) struct GaussianCloud<P, const N: usize> {
     log_w: [f32; N],
     w: [f32; N],
     anc: [u32; N],
+    last: DopplerReport,
 }
 
 impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
@@ -155,6 +168,7 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
             anc: [0; N],
             rng: Rng::seed_from_u64(0),
             frame: 0,
+            last: DopplerReport::default(),
         })
     }
 
@@ -182,6 +196,17 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
             *p = draw(&self.model, &mut self.rng);
         }
         self.frame = 0;
+        self.last = DopplerReport::default();
+    }
+
+    /// The configuration.
+    pub(crate) fn config(&self) -> &GaussConfig {
+        &self.cfg
+    }
+
+    /// The last frame's report.
+    pub(crate) fn last(&self) -> &DopplerReport {
+        &self.last
     }
 
     /// The built model.
@@ -240,7 +265,7 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
 
     /// Ends the frame: the weighted-mean estimate, systematic resampling, gather; the
     /// report carries `existence` and `log_lr` as the detector computed them.
-    pub(crate) fn finish(&mut self, existence: f32, log_lr: f32) -> TbdReport {
+    pub(crate) fn finish(&mut self, existence: f32, log_lr: f32) -> DopplerReport {
         let est = weighted_mean(
             &self.model,
             self.parts
@@ -252,23 +277,25 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
             let _ = gather_in_place(&mut self.parts, &self.anc);
         }
         self.frame += 1;
-        TbdReport {
+        self.last = DopplerReport {
             frame: self.frame,
             existence,
             log_lr,
             estimate: est,
             min_cost_estimate: None,
-        }
+        };
+        self.last
     }
 }
 
-/// The inherent constructors every Gaussian comparator has, written once: `new` (validate
-/// `cfg`, then [`FrameDetector::reset`](crate::model::doppler::FrameDetector::reset) from
-/// `seed`), `reconfigure` and `set_noise_variance`. `$t` is a `struct $t<const N: usize>`
-/// with a field `cloud: GaussianCloud<_, N>`; `$field: $init` give its other fields'
-/// values before the reset; `$new_doc` is `new`'s doc line.
-macro_rules! gauss_detector_constructors {
-    ($t:ident { $($field:ident: $init:expr),* }, $new_doc:literal) => {
+/// What every Gaussian comparator shares, written once: the inherent `new` (validate
+/// `cfg`, then reset from `seed`) and `set_noise_variance`, and the whole
+/// [`Detector`](crate::detect::Detector) impl. `$t` is a `struct $t<const N: usize>` with
+/// a field `cloud: GaussianCloud<_, N>` and inherent `advance(&mut self, z)` (one frame)
+/// and `restart(&mut self, seed)` (reset); `$field: $init` give its other fields' values
+/// before the reset; `$new_doc` is `new`'s doc line; `$score` the detections' score.
+macro_rules! gauss_detector {
+    ($t:ident { $($field:ident: $init:expr),* }, $new_doc:literal, $score:expr) => {
         impl<const N: usize> $t<N> {
             #[doc = $new_doc]
             pub fn new(
@@ -279,22 +306,8 @@ macro_rules! gauss_detector_constructors {
                     cloud: $crate::detect::gauss_cloud::GaussianCloud::new(cfg)?,
                     $($field: $init),*
                 };
-                $crate::model::doppler::FrameDetector::reset(&mut s, seed);
+                s.restart(seed);
                 Ok(s)
-            }
-
-            /// Re-validates `cfg` and restarts in place from `seed` (as [`new`](Self::new)
-            /// would), without building a detector by value: how one that lives in a
-            /// `static` (e.g. the firmware's zero-initialised ones) is set up. On error
-            /// `self` is unchanged.
-            pub fn reconfigure(
-                &mut self,
-                cfg: $crate::detect::pf_tbd::GaussConfig,
-                seed: u64,
-            ) -> $crate::Result<()> {
-                self.cloud.reconfigure(cfg)?;
-                $crate::model::doppler::FrameDetector::reset(self, seed);
-                Ok(())
             }
 
             /// Sets the assumed per-bin noise variance (e.g. estimated from the K frames).
@@ -302,6 +315,59 @@ macro_rules! gauss_detector_constructors {
                 self.cloud.set_noise_variance(v)
             }
         }
+
+        impl<const N: usize> $crate::detect::Detector for $t<N> {
+            type Frame = [$crate::Complex32];
+            type Config = $crate::detect::pf_tbd::GaussConfig;
+            type Report = $crate::model::doppler::DopplerReport;
+            const STATE: &'static [&'static str] = $crate::model::doppler::DOPPLER_STATE;
+            const SCORE: $crate::detect::ScoreKind = $score;
+
+            /// Re-validates `cfg` and restarts in place from `seed` (as `new` would),
+            /// without building a detector by value: how one that lives in a `static`
+            /// (e.g. the firmware's zero-initialised ones) is set up. On error `self` is
+            /// unchanged.
+            fn configure(
+                &mut self,
+                cfg: &$crate::detect::pf_tbd::GaussConfig,
+                seed: u64,
+            ) -> $crate::Result<()> {
+                self.cloud.reconfigure(*cfg)?;
+                self.restart(seed);
+                Ok(())
+            }
+
+            fn config(&self) -> &$crate::detect::pf_tbd::GaussConfig {
+                self.cloud.config()
+            }
+
+            fn reset(&mut self, seed: u64) {
+                self.restart(seed);
+            }
+
+            /// One frame; errors as
+            /// [`check_frame`](crate::model::doppler::check_frame) (state untouched).
+            fn step(
+                &mut self,
+                z: &[$crate::Complex32],
+            ) -> $crate::Result<$crate::model::doppler::DopplerReport> {
+                self.advance(z)
+            }
+
+            /// One detection per frame with an estimate: the posterior-mean
+            /// `[fd, fda, A]`.
+            fn detection_count(&self) -> usize {
+                usize::from(self.cloud.last().estimate.is_some())
+            }
+
+            fn detection(&self, i: usize) -> Option<$crate::detect::Detection> {
+                if i == 0 {
+                    self.cloud.last().detection(Self::SCORE)
+                } else {
+                    None
+                }
+            }
+        }
     };
 }
-pub(crate) use gauss_detector_constructors;
+pub(crate) use gauss_detector;

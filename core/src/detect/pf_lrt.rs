@@ -12,9 +12,9 @@
 //! `log_lr` is `ln L_k`; its `existence` is the per-frame evidence
 //! `1 / (1 + exp(-l_k))` of this frame's increment `l_k`.
 
-use super::gauss_cloud::{gauss_detector_constructors, GaussianCloud};
+use super::gauss_cloud::{gauss_detector, GaussianCloud};
 use crate::math;
-use crate::model::doppler::{FrameDetector, TbdReport};
+use crate::model::doppler::DopplerReport;
 use crate::{Complex32, Result};
 
 /// PF-LRT with `N` particles.
@@ -24,9 +24,10 @@ pub struct PfLrt<const N: usize> {
     log_lr: f32,
 }
 
-gauss_detector_constructors!(
+gauss_detector!(
     PfLrt { log_lr: 0.0 },
-    "Validates `cfg`; particles from `U(I_x0)`."
+    "Validates `cfg`; particles from `U(I_x0)`.",
+    crate::detect::ScoreKind::LogLikelihoodRatio
 );
 
 impl<const N: usize> PfLrt<N> {
@@ -36,10 +37,9 @@ impl<const N: usize> PfLrt<N> {
     }
 }
 
-impl<const N: usize> FrameDetector for PfLrt<N> {
-    /// One frame; errors as [`check_frame`](crate::model::doppler::check_frame) (state
-    /// untouched).
-    fn step(&mut self, z: &[Complex32]) -> Result<TbdReport> {
+impl<const N: usize> PfLrt<N> {
+    /// One frame (the `Detector::step` of this detector).
+    fn advance(&mut self, z: &[Complex32]) -> Result<DopplerReport> {
         let first = self.cloud.frame() == 0;
         self.cloud.predict_and_weigh(z, |x, m, rng| {
             if !first {
@@ -59,7 +59,8 @@ impl<const N: usize> FrameDetector for PfLrt<N> {
         Ok(self.cloud.finish(evidence, self.log_lr))
     }
 
-    fn reset(&mut self, seed: u64) {
+    /// Restarts from frame 0 (the `Detector::reset` of this detector).
+    fn restart(&mut self, seed: u64) {
         self.log_lr = 0.0;
         self.cloud.reset(seed, |m, rng| m.prior.sample(rng));
     }

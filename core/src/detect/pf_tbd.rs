@@ -13,9 +13,9 @@
 //! [`estimate_noise_variance`](crate::model::doppler::estimate_noise_variance)). Weights
 //! are normalised in the log domain.
 
-use super::gauss_cloud::{gauss_detector_constructors, CloudParticle, GaussianCloud};
+use super::gauss_cloud::{gauss_detector, CloudParticle, GaussianCloud};
 use crate::existence::Transition;
-use crate::model::doppler::{FrameDetector, TbdReport};
+use crate::model::doppler::DopplerReport;
 use crate::{Complex32, Result};
 
 pub use super::gauss_cloud::GaussConfig;
@@ -43,15 +43,15 @@ pub struct PfTbd<const N: usize> {
     cloud: GaussianCloud<Particle, N>,
 }
 
-gauss_detector_constructors!(
+gauss_detector!(
     PfTbd {},
-    "Validates `cfg` and draws the initial particles (`E_0 ~ Bernoulli`, `x ~ U(I_x0)`)."
+    "Validates `cfg` and draws the initial particles (`E_0 ~ Bernoulli`, `x ~ U(I_x0)`).",
+    crate::detect::ScoreKind::Existence
 );
 
-impl<const N: usize> FrameDetector for PfTbd<N> {
-    /// One frame; errors as [`check_frame`](crate::model::doppler::check_frame) (state
-    /// untouched).
-    fn step(&mut self, z: &[Complex32]) -> Result<TbdReport> {
+impl<const N: usize> PfTbd<N> {
+    /// One frame (the `Detector::step` of this detector).
+    fn advance(&mut self, z: &[Complex32]) -> Result<DopplerReport> {
         self.cloud
             .predict_and_weigh(z, |pt, m, rng| match m.chain.sample(pt.e, rng) {
                 Transition::Continuing => pt.x = m.motion.propagate(pt.x, rng),
@@ -69,7 +69,8 @@ impl<const N: usize> FrameDetector for PfTbd<N> {
         Ok(self.cloud.finish(pe.clamp(0.0, 1.0), 0.0))
     }
 
-    fn reset(&mut self, seed: u64) {
+    /// Restarts from frame 0 (the `Detector::reset` of this detector).
+    fn restart(&mut self, seed: u64) {
         self.cloud.reset(seed, |m, rng| {
             let e = rng.bernoulli(m.initial_existence);
             Particle {

@@ -69,6 +69,11 @@ pub const RESPONSE_ERROR_BOUND: f64 = 3e-2;
 
 /// Analysis window of the windowed DFT.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub enum Window {
     /// `w_n = 1`.
     Rectangular,
@@ -522,6 +527,11 @@ pub fn dtft(window: Window, m: usize, theta: f64) -> (f64, f64) {
 
 /// Axis-aligned box `I_x0` of births and initial particles, `x ~ U(I_x0)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct PriorBox {
     /// Doppler range (Hz).
     pub fd: (f32, f32),
@@ -671,6 +681,11 @@ pub fn estimate_noise_variance<'a>(
 /// The state-space model every OTHR detector shares (observation, motion, existence
 /// chain, birth box). Built once from its values by [`ModelConfig::build`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct ModelConfig {
     /// Bins per frame `m`.
     pub bins: usize,
@@ -755,9 +770,9 @@ pub struct Model {
     pub initial_existence: f32,
 }
 
-/// What every OTHR detector reports per frame.
+/// What every Doppler-frame detector (CRPF-TBD, PF-TBD, JOTT, PF-LRT) reports per frame.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct TbdReport {
+pub struct DopplerReport {
     /// 1-based frame number.
     pub frame: u32,
     /// Existence probability of this frame (`P_E^k` for CRPF-TBD and PF-TBD, `q_k` for
@@ -773,10 +788,18 @@ pub struct TbdReport {
     pub min_cost_estimate: Option<[f32; 3]>,
 }
 
-/// The per-frame interface the four OTHR detectors share.
-pub trait FrameDetector {
-    /// Processes one frame of `m` complex bins.
-    fn step(&mut self, frame: &[Complex32]) -> Result<TbdReport>;
-    /// Restarts from frame 0 with a new random stream.
-    fn reset(&mut self, seed: u64);
+/// Names of the Doppler-frame state `[fd, fda, A]` ([`Detector::STATE`](crate::detect::Detector::STATE)).
+pub const DOPPLER_STATE: &[&str] = &["fd_hz", "fda_hz_per_s", "amplitude"];
+
+impl DopplerReport {
+    /// The report as a [`Detection`](crate::detect::Detection): the estimate, scored by
+    /// `existence` or by the cumulative `log_lr`; `None` without an estimate.
+    pub fn detection(&self, score: crate::detect::ScoreKind) -> Option<crate::detect::Detection> {
+        let x = self.estimate?;
+        let s = match score {
+            crate::detect::ScoreKind::LogLikelihoodRatio => self.log_lr,
+            _ => self.existence,
+        };
+        Some(crate::detect::Detection::new(&x, s, None))
+    }
 }

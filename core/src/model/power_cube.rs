@@ -14,6 +14,11 @@ pub const DEG_PER_RAD: f32 = 180.0 / math::PI;
 /// Extent and resolution of the observation cube. Cell `i` on an axis spans
 /// `[start + i * size, start + (i + 1) * size)` and has its centre at `start + (i + 0.5) * size`.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct CubeGeometry {
     /// Number of range cells `U_r`.
     pub n_range: usize,
@@ -166,6 +171,11 @@ impl CubeGeometry {
 /// `(2 half_width + 1)^3` cells around the target's own cell are covered (the same
 /// truncation in the simulator and in the likelihood).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct PointSpread {
     /// Range loss `L_r`.
     pub loss_range: f32,

@@ -15,9 +15,11 @@ use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint_core::model::doppler::{estimate_noise_variance, FrameDetector, TbdReport};
+use faint_core::detect::Detector;
+use faint_core::model::doppler::{estimate_noise_variance, DopplerReport};
 use faint_core::rng::{derive_seed, Rng};
 use faint_core::statistic::{d_k, zeta_k};
+use faint_core::Complex32;
 use serde::Serialize;
 
 use crate::io::{self, plot};
@@ -190,14 +192,17 @@ impl Stats {
 }
 
 /// Runs a detector over a run's frames; returns the per-frame reports.
-pub fn run_detector(det: &mut dyn FrameDetector, run: &Run) -> Result<Vec<TbdReport>> {
+pub fn run_detector<D: Detector<Frame = [Complex32], Report = DopplerReport> + ?Sized>(
+    det: &mut D,
+    run: &Run,
+) -> Result<Vec<DopplerReport>> {
     run.frames
         .iter()
         .map(|z| det.step(z).map_err(|e| anyhow::anyhow!("{e}")))
         .collect()
 }
 
-fn doppler_error(reports: &[TbdReport], run: &Run, band: f64) -> f64 {
+fn doppler_error(reports: &[DopplerReport], run: &Run, band: f64) -> f64 {
     let mut s = 0.0;
     let mut n = 0usize;
     for (r, t) in reports.iter().zip(&run.truth).skip(13) {

@@ -18,12 +18,13 @@
 //!   of the period, so the empirical grid Pfa at every `gamma` is the fraction of trials
 //!   whose largest count reaches `gamma`, next to the model's eq. 28.
 
+use faint_core::detect::Detector;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 use faint_core::detect::hough::{
-    ClassicConfig, ClassicHough, Geometry, MhtConfig, MhtTbd, NO_PLOT,
+    ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, NO_PLOT,
 };
 
 use crate::analysis::hough_model::{self, CellModel, ChainSource, CompoundModel, ModelParams};
@@ -478,7 +479,7 @@ pub fn detectors(
     cfg.along_gate = cfg.gate;
     cfg.gamma1 = gamma1;
     let mht = Box::new(Mht::new(cfg).map_err(|e| anyhow::anyhow!("{e}"))?);
-    let ccfg = ClassicConfig {
+    let ccfg = ClassicHoughConfig {
         area: sc.area,
         n_scans: sc.n_scans,
         gamma: gamma_classic,

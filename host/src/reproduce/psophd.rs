@@ -9,6 +9,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
+use faint_core::detect::Detector;
 use std::path::PathBuf;
 use std::time::Instant;
 

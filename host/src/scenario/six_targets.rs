@@ -54,7 +54,7 @@
 //!   is how 9 dB tracks were lost (per-frame diagnostics: `examples/phd_diag.rs`).
 
 use faint_core::detect::phd::{
-    BirthComponent, BirthMode, BirthModel, Config, DbscanParams, Extractor, PsoConfig,
+    BirthComponent, BirthMode, BirthModel, DbscanParams, Extractor, PhdConfig, PsoConfig,
 };
 use faint_core::model::power_cube::{CubeGeometry, PointSpread, RadarCoords};
 use faint_core::rng::Rng;
@@ -306,13 +306,13 @@ impl SixTargets {
     }
 
     /// Filter configuration for `variant`.
-    pub fn config(&self, variant: Variant) -> Config {
+    pub fn config(&self, variant: Variant) -> PhdConfig {
         let p = self.power() as f32;
         let comp = |x: f32, y: f32| BirthComponent {
             mean: [x, 0.0, y, 0.0],
             std: [20.0; 4],
         };
-        Config {
+        PhdConfig {
             geometry: self.geometry,
             psf: self.psf,
             noise_var: self.noise_var as f32,

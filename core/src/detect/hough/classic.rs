@@ -1,17 +1,23 @@
-//! Baseline: the classic two-stage Carlson Hough TBD (Carlson, Evans, Wilson 1994;
-//! paper 003 §2): standard Hough transform of every pre-detected plot (origin at the area
+//! Baseline: the classic two-stage Carlson Hough TBD (Carlson, Evans, Wilson 1994; as
+//! described by Bao et al. 2022, §2): standard Hough transform of every pre-detected plot (origin at the area
 //! centre), binary integration over `N` scans, fixed threshold, condensing into peaks.
 //! Same grid and accumulator as MHT-TBD, no censoring, no smoothing.
 
 use super::dmht::{Accumulator, CondenseStats, Peak};
 use super::geometry::Geometry;
 use super::{in_area, validate_area};
+use crate::detect::{Detection, Detector, ScoreKind, Validate};
 use crate::model::plot::Plot;
 use crate::{Error, Result};
 
 /// Configuration of the classic detector.
 #[derive(Debug, Clone, Copy)]
-pub struct ClassicConfig {
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
+pub struct ClassicHoughConfig {
     /// Surveillance area `[x_min, x_max, y_min, y_max]` (m).
     pub area: [f32; 4],
     /// Scans per integration period `N` (blocked periods).
@@ -20,9 +26,8 @@ pub struct ClassicConfig {
     pub gamma: u8,
 }
 
-impl ClassicConfig {
-    /// Check the values.
-    pub fn validate(&self) -> Result<()> {
+impl Validate for ClassicHoughConfig {
+    fn validate(&self) -> Result<()> {
         validate_area(self.area)?;
         if self.n_scans == 0 || self.n_scans > 255 {
             return Err(Error::InvalidConfig("n_scans"));
@@ -36,7 +41,7 @@ impl ClassicConfig {
 
 /// One step's report.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct ClassicReport {
+pub struct ClassicHoughReport {
     /// Index of the scan within its period.
     pub scan_in_period: u16,
     /// Plots used from this scan.
@@ -52,17 +57,19 @@ pub struct ClassicReport {
 /// Streaming classic Hough TBD with up to `T` peaks per period.
 #[derive(Debug, Clone)]
 pub struct ClassicHough<const R: usize, const A: usize, const T: usize> {
-    cfg: ClassicConfig,
+    cfg: ClassicHoughConfig,
     geom: Geometry<R, A>,
     acc: Accumulator<R, A>,
     scan: usize,
     peaks: [Peak; T],
     npeaks: usize,
+    /// The last step completed a period.
+    done: bool,
 }
 
 impl<const R: usize, const A: usize, const T: usize> ClassicHough<R, A, T> {
     /// A detector for a validated configuration.
-    pub fn new(cfg: ClassicConfig) -> Result<Self> {
+    pub fn new(cfg: ClassicHoughConfig) -> Result<Self> {
         cfg.validate()?;
         Ok(Self {
             cfg,
@@ -71,6 +78,7 @@ impl<const R: usize, const A: usize, const T: usize> ClassicHough<R, A, T> {
             scan: 0,
             peaks: [Peak::default(); T],
             npeaks: 0,
+            done: false,
         })
     }
 
@@ -89,13 +97,15 @@ impl<const R: usize, const A: usize, const T: usize> ClassicHough<R, A, T> {
         &self.peaks[..self.npeaks]
     }
 
-    /// Feed one scan. Invalid plots (non-finite, outside the area) are skipped and counted.
-    pub fn step(&mut self, plots: &[Plot]) -> Result<ClassicReport> {
+    /// One scan (the [`Detector::step`]). Invalid plots (non-finite, outside the area)
+    /// are skipped and counted.
+    fn step_scan(&mut self, plots: &[Plot]) -> Result<ClassicHoughReport> {
+        self.done = false;
         if self.scan == 0 {
             self.acc.reset();
             self.npeaks = 0;
         }
-        let mut rep = ClassicReport {
+        let mut rep = ClassicHoughReport {
             scan_in_period: self.scan as u16,
             ..Default::default()
         };
@@ -115,7 +125,68 @@ impl<const R: usize, const A: usize, const T: usize> ClassicHough<R, A, T> {
             rep.condense = self.acc.condense(self.cfg.gamma, &mut self.peaks);
             self.npeaks = usize::from(rep.condense.peaks);
             rep.period_complete = true;
+            self.done = true;
         }
         Ok(rep)
+    }
+}
+
+impl<const R: usize, const A: usize, const T: usize> Detector for ClassicHough<R, A, T> {
+    type Frame = [Plot];
+    type Config = ClassicHoughConfig;
+    type Report = ClassicHoughReport;
+    const STATE: &'static [&'static str] = &["rho_m", "theta_rad"];
+    const SCORE: ScoreKind = ScoreKind::Count;
+
+    /// Validates `cfg`, builds the geometry and starts a new period. The classic Hough
+    /// TBD draws no random numbers: `seed` is unused.
+    fn configure(&mut self, cfg: &ClassicHoughConfig, _seed: u64) -> Result<()> {
+        cfg.validate()?;
+        self.cfg = *cfg;
+        self.geom = Geometry::for_area(cfg.area);
+        self.reset(0);
+        Ok(())
+    }
+
+    fn config(&self) -> &ClassicHoughConfig {
+        &self.cfg
+    }
+
+    /// Starts a new period.
+    fn reset(&mut self, _seed: u64) {
+        self.scan = 0;
+        self.npeaks = 0;
+        self.done = false;
+    }
+
+    fn step(&mut self, plots: &[Plot]) -> Result<ClassicHoughReport> {
+        self.step_scan(plots)
+    }
+
+    /// The peaks when the last step completed a period, none otherwise.
+    fn detection_count(&self) -> usize {
+        if self.done {
+            self.npeaks
+        } else {
+            0
+        }
+    }
+
+    /// Peak `i` (strongest first) as the line `x cos(theta) + y sin(theta) = rho` about
+    /// the area centre (its cell's centre values), scored by its binary-integration count.
+    fn detection(&self, i: usize) -> Option<Detection> {
+        if i >= self.detection_count() {
+            return None;
+        }
+        let p = self.peaks.get(i)?;
+        let (r, a) = (usize::from(p.r), usize::from(p.a));
+        if r >= R || a >= A {
+            return None;
+        }
+        Some(Detection::new(
+            &[self.geom.rho_center(r), self.geom.theta(a)],
+            f32::from(p.raw),
+            None,
+        ))
     }
 }

@@ -1,5 +1,5 @@
 //! MHT-TBD: modified Hough transform track-before-detect for dense clutter
-//! (Bao, Lu, Tian, Tian, Acta Electronica Sinica 50(7), 2022; seed 003), and the classic
+//! (Bao, Lu, Tian, Tian, Acta Electronica Sinica 50(7), 2022), and the classic
 //! Carlson Hough TBD baseline.
 //!
 //! Three stages (Fig. 1): pre-detection (outside this module: the input plots), plot
@@ -10,8 +10,8 @@
 //!
 //! Streaming: [`MhtTbd::step`] takes one scan. Integration periods are **blocked**: scans
 //! `0..N`, `N..2N`, ... form periods; the step that completes a period runs the DMHT and
-//! returns a [`Detection`] in its report; the tracks are then readable with
-//! [`MhtTbd::tracks`] until the next `step` starts a new period. Censoring windows do not
+//! returns a [`PeriodSummary`] in its report; the tracks are then readable with
+//! [`MhtTbd::tracks`] (and as [`Detection`]s, [`Detector::detections`]) until the next `step` starts a new period. Censoring windows do not
 //! cross period boundaries (the plots of a period are judged on that period's scans only,
 //! as the paper's model of a cell's `N`-scan hit sequence assumes).
 //!
@@ -36,9 +36,11 @@ pub mod dmht;
 pub mod geometry;
 
 pub use censoring::{CensorStats, MAX_M};
-pub use classic::{ClassicConfig, ClassicHough, ClassicReport};
+pub use classic::{ClassicHough, ClassicHoughConfig, ClassicHoughReport};
 pub use dmht::{Accumulator, CondenseStats, Peak, Track, NO_PLOT};
 pub use geometry::Geometry;
+
+use crate::detect::{Detection, Detector, ScoreKind, TrackInfo, Validate};
 
 use crate::model::plot::Plot;
 use crate::{math, Error, Result};
@@ -64,6 +66,11 @@ pub(crate) fn validate_area(area: [f32; 4]) -> Result<()> {
 
 /// Runtime configuration of MHT-TBD.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct MhtConfig {
     /// Surveillance area `[x_min, x_max, y_min, y_max]` (m).
     pub area: [f32; 4],
@@ -73,7 +80,7 @@ pub struct MhtConfig {
     pub n_scans: usize,
     /// Velocity gate `V_max T_scan` (m), eq. 6.
     pub gate: f32,
-    /// Detection threshold `gamma_1` on the binary-integration count of a cell (the
+    /// PeriodSummary threshold `gamma_1` on the binary-integration count of a cell (the
     /// smoothing only locates the peak, see [`Accumulator::condense`]).
     pub gamma1: u8,
     /// Apply the 3x3 Gaussian smoothing to locate the peaks.
@@ -123,14 +130,17 @@ impl MhtConfig {
             residual: true,
         }
     }
+}
 
-    /// Check the values against the capacities `NS` (scans) of a detector.
-    pub fn validate(&self, ns: usize) -> Result<()> {
+impl Validate for MhtConfig {
+    /// Checks the values (the capacity `NS` of a detector is checked by its
+    /// [`Detector::configure`]).
+    fn validate(&self) -> Result<()> {
         validate_area(self.area)?;
         if !(3..=MAX_M).contains(&self.m) {
             return Err(Error::InvalidConfig("m"));
         }
-        if self.n_scans == 0 || self.n_scans < self.m || self.n_scans > ns || self.n_scans > 64 {
+        if self.n_scans == 0 || self.n_scans < self.m || self.n_scans > 64 {
             return Err(Error::InvalidConfig("n_scans"));
         }
         if !(self.gate.is_finite() && self.gate > 0.0) {
@@ -157,7 +167,7 @@ impl MhtConfig {
 
 /// Summary of one completed integration period.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Detection {
+pub struct PeriodSummary {
     /// Plots kept over the period (pre-detection plots, after invalid/overflow).
     pub pre_plots: u32,
     /// Effective plots `|S_ep|`.
@@ -197,7 +207,7 @@ pub struct MhtReport {
     /// Censoring counters of this scan's window.
     pub censor: CensorStats,
     /// Set when this scan completed a period.
-    pub detection: Option<Detection>,
+    pub detection: Option<PeriodSummary>,
 }
 
 /// Streaming MHT-TBD detector: `P` plots per scan, `NS` scans per period at most, an
@@ -218,7 +228,7 @@ pub struct MhtTbd<const P: usize, const NS: usize, const R: usize, const A: usiz
     scan: usize,
     /// Stage-3 input summary of the period the last `step` completed (for
     /// [`MhtTbd::redetect`]); `None` otherwise.
-    period: Option<Detection>,
+    period: Option<PeriodSummary>,
 }
 
 impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: usize>
@@ -228,7 +238,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     /// (`~ NS P 13 + R A 4` bytes): box it on the host, make it `static` on a target.
     pub fn new(cfg: MhtConfig) -> Result<Self> {
         let mut d = Self::unconfigured();
-        d.configure(cfg)?;
+        d.configure(&cfg, 0)?;
         Ok(d)
     }
 
@@ -258,28 +268,6 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
             scan: usize::MAX,
             period: None,
         }
-    }
-
-    /// Validate `cfg`, build the geometry, and start a new period (in place: no large
-    /// copy, usable on a `static`).
-    pub fn configure(&mut self, cfg: MhtConfig) -> Result<()> {
-        cfg.validate(NS)?;
-        if P > usize::from(u16::MAX) || P == 0 || T == 0 {
-            return Err(Error::InvalidConfig("capacity"));
-        }
-        self.cfg = cfg;
-        self.msht = Geometry::for_area(cfg.area);
-        self.dmht = self.msht;
-        self.counts = [0; NS];
-        self.ntracks = 0;
-        self.scan = 0;
-        self.period = None;
-        Ok(())
-    }
-
-    /// The configuration.
-    pub fn config(&self) -> &MhtConfig {
-        &self.cfg
     }
 
     /// Change `gamma_1` (takes effect at the next period end).
@@ -335,8 +323,9 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
         &self.tracks[..self.ntracks]
     }
 
-    /// Feed one scan of plots. See the module doc for the handling of bad plots.
-    pub fn step(&mut self, scan_plots: &[Plot]) -> Result<MhtReport> {
+    /// One scan of plots (the [`Detector::step`]). See the module doc for the handling of
+    /// bad plots.
+    fn step_scan(&mut self, scan_plots: &[Plot]) -> Result<MhtReport> {
         let s = self.scan;
         if s >= NS {
             return Err(Error::InvalidConfig("unconfigured"));
@@ -390,7 +379,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     }
 
     /// Re-run the `gamma_1`-dependent part of stage 3 (threshold, condensing, track
-    /// recovery, confirmation, residual rule) on the period the last [`MhtTbd::step`]
+    /// recovery, confirmation, residual rule) on the period the last [`Detector::step`]
     /// completed, with `gamma1` in place of the configured `gamma_1`. Censoring and the
     /// binary integration do not depend on `gamma_1`, so the result (and
     /// [`MhtTbd::tracks`], which it replaces) is exactly what `step` would have given with
@@ -399,7 +388,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     ///
     /// Errors: `InvalidConfig("gamma1")` for 0, `InvalidConfig("no completed period")`
     /// when the last `step` did not complete a period.
-    pub fn redetect(&mut self, gamma1: u8) -> Result<Detection> {
+    pub fn redetect(&mut self, gamma1: u8) -> Result<PeriodSummary> {
         if gamma1 == 0 {
             return Err(Error::InvalidConfig("gamma1"));
         }
@@ -410,7 +399,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     }
 
     /// Stage 3 over the completed period.
-    fn detect(&mut self) -> Detection {
+    fn detect(&mut self) -> PeriodSummary {
         let det = self.integrate();
         self.period = Some(det);
         self.extract(self.cfg.gamma1, det)
@@ -418,9 +407,9 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
 
     /// Stage 3, the part independent of `gamma_1`: DMHT geometry, binary integration and
     /// smoothing of `S_ep`.
-    fn integrate(&mut self) -> Detection {
+    fn integrate(&mut self) -> PeriodSummary {
         let ns = self.cfg.n_scans;
-        let mut det = Detection::default();
+        let mut det = PeriodSummary::default();
         // centroid and extent of S_ep (f64-free: two-pass in f32 about the area centre)
         let (ax, ay) = self.msht.origin();
         let (mut sx, mut sy, mut ne) = (0.0f32, 0.0f32, 0u32);
@@ -478,7 +467,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
 
     /// Stage 3, the part that depends on `gamma_1`: threshold, condensing, track recovery
     /// and confirmation (an empty accumulator gives no peaks).
-    fn extract(&mut self, gamma1: u8, mut det: Detection) -> Detection {
+    fn extract(&mut self, gamma1: u8, mut det: PeriodSummary) -> PeriodSummary {
         let ns = self.cfg.n_scans;
         det.condense = self.acc.condense(gamma1, &mut self.peaks);
         // track recovery
@@ -547,5 +536,98 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
         self.ntracks = nt;
         det.tracks = nt as u16;
         det
+    }
+}
+
+impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: usize> Detector
+    for MhtTbd<P, NS, R, A, T>
+{
+    type Frame = [Plot];
+    type Config = MhtConfig;
+    type Report = MhtReport;
+    const STATE: &'static [&'static str] = &["x_m", "y_m", "vx_m_per_scan", "vy_m_per_scan"];
+    const SCORE: ScoreKind = ScoreKind::Count;
+
+    /// Validates `cfg` against the capacities (`n_scans <= NS`, `0 < P <= 65535`,
+    /// `T > 0`), builds the geometry and starts a new period, in place (no large copy,
+    /// usable on a `static`). MHT-TBD draws no random numbers: `seed` is unused.
+    fn configure(&mut self, cfg: &MhtConfig, _seed: u64) -> Result<()> {
+        cfg.validate()?;
+        if cfg.n_scans > NS {
+            return Err(Error::InvalidConfig("n_scans"));
+        }
+        if P > usize::from(u16::MAX) || P == 0 || T == 0 {
+            return Err(Error::InvalidConfig("capacity"));
+        }
+        self.cfg = *cfg;
+        self.msht = Geometry::for_area(cfg.area);
+        self.dmht = self.msht;
+        self.counts = [0; NS];
+        self.ntracks = 0;
+        self.scan = 0;
+        self.period = None;
+        Ok(())
+    }
+
+    fn config(&self) -> &MhtConfig {
+        &self.cfg
+    }
+
+    /// Starts a new period (an unconfigured detector stays unconfigured).
+    fn reset(&mut self, _seed: u64) {
+        if self.scan < NS {
+            self.counts = [0; NS];
+            self.ntracks = 0;
+            self.scan = 0;
+            self.period = None;
+        }
+    }
+
+    fn step(&mut self, scan_plots: &[Plot]) -> Result<MhtReport> {
+        self.step_scan(scan_plots)
+    }
+
+    /// The confirmed tracks when the last step completed a period, none otherwise.
+    fn detection_count(&self) -> usize {
+        if self.period.is_some() {
+            self.ntracks
+        } else {
+            0
+        }
+    }
+
+    /// Track `i`: its last associated plot `[x, y]` and the velocity from its first to
+    /// its last plot, `(p_last - p_first) / (s_last - s_first)` (m per scan, 0 for a
+    /// single-scan track); scored by the peak cell's binary-integration count; track id
+    /// `i` (strongest first), length the associated plots.
+    fn detection(&self, i: usize) -> Option<Detection> {
+        if i >= self.detection_count() {
+            return None;
+        }
+        let t = self.tracks.get(i)?;
+        let n = self.cfg.n_scans.min(NS);
+        let plot_of = |s: usize| {
+            let k = *t.plots.get(s)?;
+            if k == NO_PLOT {
+                return None;
+            }
+            self.scan_plots(s).get(usize::from(k)).map(|p| (s, *p))
+        };
+        let first = (0..n).find_map(plot_of)?;
+        let last = (0..n).rev().find_map(plot_of)?;
+        let ds = (last.0 - first.0) as f32;
+        let (vx, vy) = if ds > 0.0 {
+            ((last.1.x - first.1.x) / ds, (last.1.y - first.1.y) / ds)
+        } else {
+            (0.0, 0.0)
+        };
+        Some(Detection::new(
+            &[last.1.x, last.1.y, vx, vy],
+            f32::from(t.peak.raw),
+            Some(TrackInfo {
+                id: i as u32,
+                len: u32::from(t.n_plots),
+            }),
+        ))
     }
 }

@@ -17,6 +17,11 @@ pub const NOISE: i32 = -1;
 
 /// DBSCAN parameters: radius `E` and density threshold `Th_min`.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct DbscanParams {
     /// Neighbourhood radius `E` (m).
     pub eps: f32,

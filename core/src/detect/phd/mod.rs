@@ -4,7 +4,7 @@
 //! an NSGA-II multi-objective particle swarm step between prediction and update, and
 //! DBSCAN state extraction; the plain PHD-TBD and K-means extraction are the baselines.
 //!
-//! - [`smc_phd`]: the filter ([`SmcPhdTbd`], [`Config`], [`Report`]).
+//! - [`smc_phd`]: the filter ([`SmcPhdTbd`], [`PhdConfig`], [`PhdReport`]).
 //! - [`pso`]: swarm, ENS-BS non-dominated sort (O(N) memory), weighted crowding.
 //! - [`ndsort`]: divide-and-conquer non-dominated sort for three or more objectives.
 //! - [`dbscan`]: grid-indexed DBSCAN.
@@ -22,7 +22,7 @@ pub use dbscan::{Dbscan, DbscanParams};
 pub use kmeans::KMeans;
 pub use pso::{PsoConfig, Swarm};
 pub use smc_phd::{
-    BirthComponent, BirthMode, BirthModel, Config, Estimate, Extractor, Report, SmcPhdTbd,
+    BirthComponent, BirthMode, BirthModel, Estimate, Extractor, PhdConfig, PhdReport, SmcPhdTbd,
     MAX_BIRTH_COMPONENTS,
 };
 pub use variant::Variant;

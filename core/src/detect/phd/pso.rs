@@ -202,6 +202,11 @@ pub fn crowding_distance<const M: usize>(
 
 /// PSO settings (eq. 8-9, 18-19 and the stop rule).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct PsoConfig {
     /// Generations run every frame, `gen` (paper: 10). §3.1: "after the iteration count
     /// is reached, the fitness threshold is the final condition for ending the

@@ -24,6 +24,7 @@
 use super::dbscan::{Dbscan, DbscanParams};
 use super::kmeans::KMeans;
 use super::pso::{PsoConfig, Swarm};
+use crate::detect::{Detection, Detector, ScoreKind, Validate};
 use crate::math::{self, KahanSum};
 use crate::model::power_cube::{
     AxisWeights, CubeGeometry, PointSpread, PowerCube, RadarCoords, DEG_PER_RAD,
@@ -39,6 +40,11 @@ pub const MAX_BIRTH_CELLS: usize = 16;
 
 /// One birth component: Gaussian over `[x, vx, y, vy]` with independent axes.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct BirthComponent {
     /// Mean `[x, vx, y, vy]`.
     pub mean: [f32; 4],
@@ -48,6 +54,11 @@ pub struct BirthComponent {
 
 /// How birth particles are drawn.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub enum BirthMode {
     /// From the Gaussian mixture (equal component weights), as in the paper.
     Gaussian,
@@ -72,6 +83,11 @@ pub enum BirthMode {
 
 /// Birth density.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct BirthModel {
     /// Components (the first `n_components` are used).
     pub components: [BirthComponent; MAX_BIRTH_COMPONENTS],
@@ -89,6 +105,11 @@ pub struct BirthModel {
 
 /// State extractor.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub enum Extractor {
     /// DBSCAN on positions; the `N_hat` largest clusters' mean states.
     Dbscan(DbscanParams),
@@ -101,7 +122,12 @@ pub enum Extractor {
 
 /// Runtime configuration.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Config {
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
+pub struct PhdConfig {
     /// Cube extent and cell sizes.
     pub geometry: CubeGeometry,
     /// Point spread (eq. 3).
@@ -136,9 +162,9 @@ pub struct Config {
     pub extractor: Extractor,
 }
 
-impl Config {
+impl Validate for PhdConfig {
     /// Checks every value (called by [`SmcPhdTbd::new`]).
-    pub fn validate(&self) -> Result<()> {
+    fn validate(&self) -> Result<()> {
         self.geometry.validate()?;
         self.psf.validate()?;
         let pos = |v: f32| v.is_finite() && v > 0.0;
@@ -228,7 +254,7 @@ pub struct Estimate {
 
 /// Per-frame summary.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Report {
+pub struct PhdReport {
     /// `N_hat = round(sum w)`, capped at the capacity `K`.
     pub n_hat: usize,
     /// Posterior PHD mass `sum w`.
@@ -257,7 +283,7 @@ pub struct Report {
 /// set up by [`SmcPhdTbd::reconfigure`].
 #[derive(Debug, Clone)]
 pub struct SmcPhdTbd<const N: usize, const S: usize, const M: usize, const K: usize> {
-    cfg: Config,
+    cfg: PhdConfig,
     x: [[f32; 5]; N],
     w: [f32; N],
     n: usize,
@@ -324,7 +350,7 @@ fn log_add_exp(a: f32, b: f32) -> f32 {
 impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N, S, M, K> {
     /// A filter with an empty PHD (the first frame's births populate it).
     /// Errors: invalid config, `J >= N`, more PSO points than `M`, `K == 0`.
-    pub fn new(cfg: Config, seed: u64) -> Result<Self> {
+    pub fn new(cfg: PhdConfig, seed: u64) -> Result<Self> {
         Self::check(&cfg)?;
         Ok(Self {
             cfg,
@@ -354,7 +380,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         })
     }
 
-    fn check(cfg: &Config) -> Result<()> {
+    fn check(cfg: &PhdConfig) -> Result<()> {
         cfg.validate()?;
         if K == 0 || N < 2 || N > u32::MAX as usize {
             return Err(Error::InvalidConfig("capacities"));
@@ -376,32 +402,6 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         Ok(())
     }
 
-    /// Re-validates `cfg` and restarts in place from `seed`, behaving exactly as
-    /// [`new`](Self::new)`(cfg, seed)` would, without building the (large) filter by
-    /// value: how one that lives in a `static` is set up, including from the all-zero
-    /// value (e.g. the firmware's `.bss` detectors). On error `self` is unchanged.
-    pub fn reconfigure(&mut self, cfg: Config, seed: u64) -> Result<()> {
-        Self::check(&cfg)?;
-        self.cfg = cfg;
-        self.reset(seed);
-        Ok(())
-    }
-
-    /// Empties the PHD and reseeds (same configuration).
-    pub fn reset(&mut self, seed: u64) {
-        self.n = 0;
-        self.n_est = 0;
-        self.n_z = 0;
-        self.rng = Rng::seed_from_u64(seed);
-        self.birth_nb = [0; MAX_BIRTH_COMPONENTS];
-        self.birth_prev_nb = [0; MAX_BIRTH_COMPONENTS];
-    }
-
-    /// The configuration.
-    pub fn config(&self) -> &Config {
-        &self.cfg
-    }
-
     /// Extracted states of the last frame.
     pub fn estimates(&self) -> &[Estimate] {
         &self.est[..self.n_est]
@@ -417,7 +417,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         &self.zpts[..self.n_z]
     }
 
-    /// Processes one power cube (`geometry.len()` cells, layout of
+    /// One power cube (the [`Detector::step`]; `geometry.len()` cells, layout of
     /// [`crate::model::power_cube`]). Bad cubes (wrong length, NaN/inf, negative power)
     /// are rejected before any state changes.
     ///
@@ -439,9 +439,9 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
     /// change over `T` as well was measured to lose most tracks), grouped by nearest
     /// point: the elitist selection keeps each group's particle count and the PHD mass
     /// is preserved per group.
-    pub fn step(&mut self, cube: &[f32]) -> Result<Report> {
+    fn step_cube(&mut self, cube: &[f32]) -> Result<PhdReport> {
         let cube = PowerCube::new(cube, self.cfg.geometry)?;
-        let mut report = Report::default();
+        let mut report = PhdReport::default();
         self.predict();
         let n_surv = self.n;
         self.add_births();
@@ -1112,5 +1112,62 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             }
         }
         Ok(())
+    }
+}
+
+impl<const N: usize, const S: usize, const M: usize, const K: usize> Detector
+    for SmcPhdTbd<N, S, M, K>
+{
+    type Frame = [f32];
+    type Config = PhdConfig;
+    type Report = PhdReport;
+    const STATE: &'static [&'static str] = &["x_m", "vx_m_per_s", "y_m", "vy_m_per_s", "intensity"];
+    const SCORE: ScoreKind = ScoreKind::Mass;
+
+    /// Re-validates `cfg` and restarts in place from `seed`, behaving exactly as
+    /// [`SmcPhdTbd::new`]`(cfg, seed)` would, without building the (large) filter by
+    /// value: how one that lives in a `static` is set up, including from the all-zero
+    /// value (e.g. the firmware's `.bss` detectors). On error `self` is unchanged.
+    fn configure(&mut self, cfg: &PhdConfig, seed: u64) -> Result<()> {
+        Self::check(cfg)?;
+        self.cfg = *cfg;
+        self.reset(seed);
+        Ok(())
+    }
+
+    fn config(&self) -> &PhdConfig {
+        &self.cfg
+    }
+
+    /// Empties the PHD and reseeds (same configuration).
+    fn reset(&mut self, seed: u64) {
+        self.n = 0;
+        self.n_est = 0;
+        self.n_z = 0;
+        self.rng = Rng::seed_from_u64(seed);
+        self.birth_nb = [0; MAX_BIRTH_COMPONENTS];
+        self.birth_prev_nb = [0; MAX_BIRTH_COMPONENTS];
+    }
+
+    fn step(&mut self, cube: &[f32]) -> Result<PhdReport> {
+        self.step_cube(cube)
+    }
+
+    fn detection_count(&self) -> usize {
+        self.n_est
+    }
+
+    /// Extracted state `i` (largest cluster first), scored by its PHD mass: the
+    /// resampled particles carry equal weights `w = mass / n`, so a cluster of `support`
+    /// particles holds `support * w`.
+    fn detection(&self, i: usize) -> Option<Detection> {
+        let e = self.estimates().get(i)?;
+        let w = self
+            .w
+            .get(..self.n)
+            .and_then(|w| w.first())
+            .copied()
+            .unwrap_or(0.0);
+        Some(Detection::new(&e.state, e.support as f32 * w, None))
     }
 }
