@@ -5,8 +5,9 @@
 //!
 //! - [`montecarlo`]: parallel trials with per-trial seeds, identical for any thread count.
 //! - [`stats`]: thresholds at a false-alarm rate, detection rates with confidence
-//!   intervals, Pd-versus-SNR crossings, ROC, OSPA.
-//! - [`io`]: CSV, JSON, Markdown tables and SVG plots.
+//!   intervals, Pd-versus-SNR crossings, ROC, OSPA, GOSPA.
+//! - [`io`]: CSV, JSON, Markdown tables and SVG plots; recorded frames and plot lists
+//!   read from and written to `.npy`/`.npz`/CSV.
 //! - [`scenario`]: one module per paper's scene (presets are data).
 //! - [`reproduce`]: one module per paper, behind `faint reproduce <name>`.
 

@@ -1,4 +1,6 @@
-//! Output: CSV and JSON files, Markdown tables, and SVG plots ([`plot`]).
+//! Output: CSV and JSON files, Markdown tables, and SVG plots ([`plot`]); recorded
+//! frames and plot lists read from `.npy`/`.npz`/CSV ([`input`]) and written in the same
+//! formats ([`output`]).
 //!
 //! Every writer creates missing parent folders and names the file in its error.
 
@@ -8,6 +10,8 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use serde::Serialize;
 
+pub mod input;
+pub mod output;
 pub mod plot;
 
 fn ensure_parent(path: &Path) -> Result<()> {
