@@ -18,7 +18,6 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Result};
 use faint_core::model::plot::Plot;
 use faint_core::Complex32;
-use npyz::npz::NpzArchive;
 use npyz::{DType, NpyFile, TypeChar};
 use num_complex::Complex64;
 
@@ -305,9 +304,12 @@ fn read_array(path: &Path) -> Result<Array> {
             .map_err(|e| anyhow!("{p}: not a valid .npy file (bad or truncated header): {e}"))?;
         decode(path, npy)
     } else if bytes.starts_with(b"PK") {
-        let mut npz = NpzArchive::new(Cursor::new(&bytes[..]))
+        let mut npz = zip::ZipArchive::new(Cursor::new(&bytes[..]))
             .map_err(|e| anyhow!("{p}: not a valid .npz archive: {e}"))?;
-        let mut names: Vec<String> = npz.array_names().map(str::to_string).collect();
+        let mut names: Vec<String> = npz
+            .file_names()
+            .filter_map(|n| Some(n.ok()?.strip_suffix(".npy")?.to_string()))
+            .collect();
         names.sort();
         let name = if names.iter().any(|n| n == "frames") {
             "frames".to_string()
@@ -322,10 +324,14 @@ fn read_array(path: &Path) -> Result<Array> {
                 names.join(", ")
             );
         };
-        let npy = npz
-            .by_name(&name)
-            .map_err(|e| anyhow!("{p}: array `{name}` is not a valid .npy entry: {e}"))?
-            .ok_or_else(|| anyhow!("{p}: array `{name}` is missing from the archive"))?;
+        let mut entry = npz
+            .by_name(&format!("{name}.npy"))
+            .map_err(|e| anyhow!("{p}: array `{name}` cannot be read from the archive: {e}"))?;
+        let mut inner = Vec::new();
+        std::io::Read::read_to_end(&mut entry, &mut inner)
+            .map_err(|e| anyhow!("{p}: array `{name}` cannot be decompressed: {e}"))?;
+        let npy = NpyFile::new(&inner[..])
+            .map_err(|e| anyhow!("{p}: array `{name}` is not a valid .npy entry: {e}"))?;
         decode(path, npy).map_err(|e| anyhow!("{e} (array `{name}`)"))
     } else {
         bail!("{p}: not a NumPy .npy or .npz file (no \\x93NUMPY or PK signature)");
