@@ -10,10 +10,14 @@
 //!   read from and written to `.npy`/`.npz`/CSV.
 //! - [`scenario`]: one module per paper's scene (presets are data).
 //! - [`reproduce`]: one module per paper, behind `faint reproduce <name>`.
+//! - [`detect`]: every detector on a user's files, behind `faint detect <name>`.
+//! - [`simulate`]: a preset's frames and truth as files, behind `faint simulate <scenario>`.
 
 pub mod analysis;
+pub mod detect;
 pub mod io;
 pub mod montecarlo;
 pub mod reproduce;
 pub mod scenario;
+pub mod simulate;
 pub mod stats;

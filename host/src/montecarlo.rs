@@ -17,7 +17,9 @@ pub fn set_quiet(quiet: bool) {
     QUIET.store(quiet, Ordering::Relaxed);
 }
 
-fn progress_bar(label: &str, n: usize) -> ProgressBar {
+/// A progress bar of `n` steps labelled `label`, drawn on stderr when it is a terminal and
+/// hidden after [`set_quiet`]`(true)`.
+pub fn progress_bar(label: &str, n: usize) -> ProgressBar {
     let target = if QUIET.load(Ordering::Relaxed) {
         ProgressDrawTarget::hidden()
     } else {

@@ -1046,13 +1046,14 @@ impl<const N: usize> CrpfTbd<N> {
         self.prev[..m].copy_from_slice(z);
         self.prev_zz = zz;
         self.frame += 1;
-        Ok(DopplerReport {
+        self.last = DopplerReport {
             frame: self.frame,
             existence: count as f32 / N as f32,
             log_lr: 0.0,
             estimate: mean,
             min_cost_estimate: min,
-        })
+        };
+        Ok(self.last)
     }
 
     /// Mean-cost and min-cost estimates (eq. 8) over the `E = 1` particles, with

@@ -772,6 +772,7 @@ pub struct Model {
 
 /// What every Doppler-frame detector (CRPF-TBD, PF-TBD, JOTT, PF-LRT) reports per frame.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct DopplerReport {
     /// 1-based frame number.
     pub frame: u32,

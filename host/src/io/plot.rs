@@ -134,6 +134,151 @@ pub fn histogram(
     line_chart(path, title, x_label, "density", &series)
 }
 
+/// One cell of a [`heatmap`]: `[x0, x1) x [y0, y1)` with a value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cell {
+    /// Lower x edge.
+    pub x0: f64,
+    /// Upper x edge.
+    pub x1: f64,
+    /// Lower y edge.
+    pub y0: f64,
+    /// Upper y edge.
+    pub y1: f64,
+    /// Value (mapped linearly from its minimum, white, to its maximum, black).
+    pub value: f64,
+}
+
+/// A grey-scale map of `cells` with `tracks` drawn over it as coloured markers, written as
+/// SVG (e.g. the power of every frame and bin with a detector's estimates).
+pub fn heatmap(
+    path: impl AsRef<Path>,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    cells: &[Cell],
+    tracks: &[Series],
+) -> Result<()> {
+    let path = path.as_ref();
+    super::ensure_parent(path)?;
+    let (x0, x1) = range(cells.iter().flat_map(|c| [c.x0, c.x1]))?;
+    let (y0, y1) = range(cells.iter().flat_map(|c| [c.y0, c.y1]))?;
+    let (v0, v1) = range(cells.iter().map(|c| c.value))?;
+    let root = SVGBackend::new(path, (900, 600)).into_drawing_area();
+    let e = |e: DrawingAreaErrorKind<_>| anyhow!("plotting {}: {e:?}", path.display());
+    root.fill(&WHITE).map_err(e)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 22))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .draw()
+        .map_err(e)?;
+    chart
+        .draw_series(cells.iter().filter(|c| c.value.is_finite()).map(|c| {
+            let g = (255.0 * (1.0 - (c.value - v0) / (v1 - v0))).clamp(0.0, 255.0) as u8;
+            Rectangle::new([(c.x0, c.y0), (c.x1, c.y1)], RGBColor(g, g, g).filled())
+        }))
+        .map_err(e)?;
+    markers(&mut chart, tracks, e)?;
+    root.present().map_err(e)?;
+    Ok(())
+}
+
+/// A scatter of `background` points (small, grey) with `series` over them as coloured
+/// markers and a legend, written as SVG (e.g. every plot of every scan with the tracks
+/// found in them).
+pub fn scatter(
+    path: impl AsRef<Path>,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    background: &[(f64, f64)],
+    series: &[Series],
+) -> Result<()> {
+    let path = path.as_ref();
+    super::ensure_parent(path)?;
+    let all = || {
+        background
+            .iter()
+            .copied()
+            .chain(series.iter().flat_map(|s| s.points.iter().copied()))
+    };
+    let (x0, x1) = range(all().map(|p| p.0))?;
+    let (y0, y1) = range(all().map(|p| p.1))?;
+    let root = SVGBackend::new(path, (900, 800)).into_drawing_area();
+    let e = |e: DrawingAreaErrorKind<_>| anyhow!("plotting {}: {e:?}", path.display());
+    root.fill(&WHITE).map_err(e)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 22))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .draw()
+        .map_err(e)?;
+    let grey = RGBColor(190, 190, 190);
+    chart
+        .draw_series(
+            background
+                .iter()
+                .filter(|p| p.0.is_finite() && p.1.is_finite())
+                .map(|&p| Circle::new(p, 1, grey.filled())),
+        )
+        .map_err(e)?;
+    markers(&mut chart, series, e)?;
+    root.present().map_err(e)?;
+    Ok(())
+}
+
+type Chart<'a, 'b> = ChartContext<
+    'a,
+    SVGBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// Draws each series as filled markers with a legend entry.
+fn markers<'a, 'b: 'a, E>(
+    chart: &mut Chart<'a, 'b>,
+    series: &[Series],
+    e: impl Fn(DrawingAreaErrorKind<<SVGBackend<'b> as DrawingBackend>::ErrorType>) -> E,
+) -> std::result::Result<(), E> {
+    for (k, s) in series.iter().enumerate() {
+        let col = COLOURS[k % COLOURS.len()];
+        chart
+            .draw_series(
+                s.points
+                    .iter()
+                    .filter(|p| p.0.is_finite() && p.1.is_finite())
+                    .map(|&p| Circle::new(p, 3, col.filled())),
+            )
+            .map_err(&e)?
+            .label(s.name.clone())
+            .legend(move |(x, y)| Circle::new((x + 10, y), 3, col.filled()));
+    }
+    if !series.is_empty() {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(&e)?;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -164,6 +309,37 @@ mod tests {
         )
         .unwrap();
         assert!(line_chart(dir.join("e.svg"), "t", "x", "y", &[]).is_err());
+        let track = [Series {
+            name: "track".into(),
+            points: vec![(0.5, 0.5)],
+        }];
+        let cell = |x: f64, v: f64| Cell {
+            x0: x,
+            x1: x + 1.0,
+            y0: 0.0,
+            y1: 1.0,
+            value: v,
+        };
+        heatmap(
+            dir.join("m.svg"),
+            "map",
+            "x",
+            "y",
+            &[cell(0.0, 1.0), cell(1.0, 2.0)],
+            &track,
+        )
+        .unwrap();
+        scatter(
+            dir.join("s.svg"),
+            "sc",
+            "x",
+            "y",
+            &[(0.0, 0.0), (1.0, 2.0)],
+            &track,
+        )
+        .unwrap();
+        let m = std::fs::read_to_string(dir.join("m.svg")).unwrap();
+        assert!(m.contains("<rect") && m.contains("track"));
         std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -30,6 +30,7 @@ pub const FLAG_EFFECTIVE: u8 = 1;
 
 /// Counters of one censoring step.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct CensorStats {
     /// Gated pairs between the previous scan and this one.
     pub pairs: u32,

@@ -41,6 +41,7 @@ impl Validate for ClassicHoughConfig {
 
 /// One step's report.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct ClassicHoughReport {
     /// Index of the scan within its period.
     pub scan_in_period: u16,

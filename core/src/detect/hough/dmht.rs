@@ -33,6 +33,7 @@ pub struct Peak {
 
 /// Counters of one condensing pass.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct CondenseStats {
     /// Peaks written.
     pub peaks: u16,

@@ -167,6 +167,7 @@ impl Validate for MhtConfig {
 
 /// Summary of one completed integration period.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct PeriodSummary {
     /// Plots kept over the period (pre-detection plots, after invalid/overflow).
     pub pre_plots: u32,
@@ -193,6 +194,7 @@ pub struct PeriodSummary {
 
 /// One step's report.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct MhtReport {
     /// Index of this scan within its period.
     pub scan_in_period: u16,

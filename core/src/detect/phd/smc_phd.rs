@@ -254,6 +254,7 @@ pub struct Estimate {
 
 /// Per-frame summary.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct PhdReport {
     /// `N_hat = round(sum w)`, capped at the capacity `K`.
     pub n_hat: usize,
