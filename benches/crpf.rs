@@ -9,7 +9,7 @@ use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint::core::detect::Detector;
+use faint::core::detect::{run, Detector};
 use faint::core::model::doppler::{estimate_noise_variance, DopplerReport};
 use faint::core::rng::Rng;
 use faint::core::Complex32;
@@ -22,9 +22,11 @@ fn run_all<D: Detector<Frame = [Complex32], Report = DopplerReport>>(
 ) -> f32 {
     d.reset(7);
     let mut acc = 0.0;
-    for z in frames {
-        acc += d.step(black_box(z)).map(|r| r.existence).unwrap_or(0.0);
-    }
+    let _ = run(
+        d,
+        frames.iter().map(|z| black_box(z.as_slice())),
+        |_, _, r| acc += r.existence,
+    );
     acc
 }
 

@@ -7,3 +7,8 @@
 
 pub use faint_core as core;
 pub use faint_host as host;
+
+/// The README's Rust examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

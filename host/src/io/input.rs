@@ -338,7 +338,7 @@ fn read_array(path: &Path) -> Result<Array> {
     }
 }
 
-fn decode<R: std::io::Read>(path: &Path, npy: NpyFile<R>) -> Result<Array> {
+fn decode(path: &Path, npy: NpyFile<&[u8]>) -> Result<Array> {
     let p = path.display();
     let dtype = npy.dtype();
     let dtype_name = dtype_name(&dtype);
@@ -405,10 +405,10 @@ fn decode<R: std::io::Read>(path: &Path, npy: NpyFile<R>) -> Result<Array> {
     })
 }
 
-/// Reads `count` elements of `size` bytes from the data part of `npy` and decodes each
-/// with `f`.
-fn read_le<R: std::io::Read, T>(
-    npy: NpyFile<R>,
+/// Decodes `count` elements of `size` bytes from the data part of `npy` (in memory) with
+/// `f`.
+fn read_le<T>(
+    npy: NpyFile<&[u8]>,
     count: u64,
     size: usize,
     f: impl Fn(&[u8]) -> T,
@@ -417,9 +417,11 @@ fn read_le<R: std::io::Read, T>(
     let bytes = n
         .checked_mul(size)
         .ok_or_else(|| std::io::Error::other("too many samples"))?;
-    let mut raw = vec![0u8; bytes];
-    npy.into_inner().read_exact(&mut raw)?;
-    Ok(raw.chunks_exact(size).map(f).collect())
+    let raw = npy.into_inner();
+    let data = raw
+        .get(..bytes)
+        .ok_or_else(|| std::io::Error::from(std::io::ErrorKind::UnexpectedEof))?;
+    Ok(data.chunks_exact(size).map(f).collect())
 }
 
 /// Gathers `data` (element at index `i` stored at `sum_k i_k strides[k]`) into C order.

@@ -196,10 +196,12 @@ pub fn run_detector<D: Detector<Frame = [Complex32], Report = DopplerReport> + ?
     det: &mut D,
     run: &Run,
 ) -> Result<Vec<DopplerReport>> {
-    run.frames
-        .iter()
-        .map(|z| det.step(z).map_err(|e| anyhow::anyhow!("{e}")))
-        .collect()
+    let mut out = Vec::with_capacity(run.frames.len());
+    faint_core::detect::run(det, run.frames.iter().map(|z| z.as_slice()), |_, _, r| {
+        out.push(*r)
+    })
+    .map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok(out)
 }
 
 fn doppler_error(reports: &[DopplerReport], run: &Run, band: f64) -> f64 {
