@@ -18,6 +18,8 @@
 //!   caller's index buffer, in-place gather, effective sample size.
 //! - [`existence`]: the two-state Markov chain of target existence shared by the
 //!   existence-carrying filters.
+//! - [`scene`]: allocation-free scene synthesis (clutter plots, detections, power-cube
+//!   returns) shared by the host simulators, the golden cases and the firmware.
 //! - [`Complex32`]: complex samples, from `num-complex`.
 #![no_std]
 #![forbid(unsafe_code)]
@@ -37,6 +39,7 @@ pub mod math;
 pub mod model;
 pub mod particles;
 pub mod rng;
+pub mod scene;
 pub mod statistic;
 
 pub use error::Error;

@@ -188,6 +188,17 @@ pub fn max_log(logs: &[f32]) -> Result<f32> {
     Ok(m)
 }
 
+/// `ln(e^a + e^b)` without overflow: `max + ln1p(exp(min - max))`, exact when either
+/// argument is `-inf` (the other is returned).
+#[inline]
+pub fn log_add_exp(a: f32, b: f32) -> f32 {
+    let (hi, lo) = if a > b { (a, b) } else { (b, a) };
+    if lo == f32::NEG_INFINITY {
+        return hi;
+    }
+    hi + ln1p(exp(lo - hi))
+}
+
 /// `log(sum_i exp(l_i))` without overflow: `m + log(sum_i exp(l_i - m))`, `m = max l_i`.
 ///
 /// `-inf` terms contribute zero. Errors as [`max_log`].

@@ -228,6 +228,125 @@ fn multinomial<I: ParticleIndex>(
     Ok(())
 }
 
+/// Systematic resampling of `anc.len()` ancestors, the same result and the same single
+/// draw as [`resample`]`(Scheme::Systematic, w, anc, rng)` (test
+/// `systematic_with_sum_equals_resample`) for weights in `[0, 1]`, in
+/// fewer passes: `sum` is the caller's compensated sum of `w` (a [`KahanSum`] in index
+/// order, what `resample` computes), the quantised weights `q_i = floor(w_i 2^31 / sum)`
+/// are computed once into `scratch` (as bits) instead of twice, and the checks of
+/// `resample` for negative or non-finite weights are not repeated (a non-finite weight
+/// makes `sum` non-finite). Returns `false`, with nothing drawn, where `resample` errs.
+/// `scratch` must have `w.len()` entries. CRPF-TBD's resampler.
+pub fn systematic_with_sum(
+    w: &[f32],
+    sum: f32,
+    scratch: &mut [f32],
+    anc: &mut [u32],
+    rng: &mut Rng,
+) -> bool {
+    if !(sum > 0.0 && sum.is_finite()) || w.is_empty() || w.len() != scratch.len() {
+        return false;
+    }
+    let mut scale = 2_147_483_648.0f32 / sum;
+    if !scale.is_finite() {
+        return false;
+    }
+    scale *= 1.0 - 4.0 * f32::EPSILON;
+    let mut total = 0u64;
+    for (q, &x) in scratch.iter_mut().zip(w.iter()) {
+        // As `particles::quantise`: x * scale <= 2^31 (1 + eps) fits a u32.
+        let v = (x * scale) as u32;
+        *q = f32::from_bits(v);
+        total += v as u64;
+    }
+    if total == 0 {
+        return false;
+    }
+    // Position j is (a + j T) / M; j goes to the first i with a + j T < M C_i. The walk
+    // keeps `gap = M C_i - (a + j T)` (exact in i64: both terms are below 2^45 for
+    // M < 2^13, and below 2^63 for any M < 2^31) and advances i while `gap <= 0`.
+    let m = anc.len() as u64;
+    let a = (rng.next_u32() as u64 * total) >> 32;
+    let mut qs = scratch.iter().map(|q| q.to_bits() as u64);
+    let mut i = 0u32;
+    let mut gap = (m * qs.next().unwrap_or(0)) as i64 - a as i64;
+    let step_value = total as i64;
+    // Read from memory by one `ldrd` per slot (opaque reference) instead of being
+    // spilled and reloaded word by word.
+    let step = core::hint::black_box(&step_value);
+    for slot in anc.iter_mut() {
+        while gap <= 0 {
+            match qs.next() {
+                Some(q) => {
+                    i += 1;
+                    gap += (m * q) as i64;
+                }
+                None => break,
+            }
+        }
+        *slot = i;
+        gap -= *step;
+    }
+    true
+}
+
+/// A particle state that [`gather_flagged`] moves field by field.
+pub trait FlaggedState {
+    /// Copies `from` into `self`; `all` is the gather's `ALL` (a caller may skip fields it
+    /// reads only then).
+    fn copy_from(&mut self, from: &Self, all: bool);
+}
+
+/// `parts[j] = old parts[anc[j]]`, `flags[j] = old flags[anc[j]]` in place for sorted
+/// ancestors (what [`resample`] produces), like [`gather_in_place`] (same two passes:
+/// ascending for `a > j`, descending for `a < j`; test `gather_flagged_equals_gather`)
+/// but for a structure of arrays of states and flags, moving a state with
+/// [`FlaggedState::copy_from`] and, unless `ALL`, only where its flag is set (a state
+/// with a clear flag is never read: CRPF-TBD's absent particles when `lambda = 0`).
+/// Out-of-range ancestors are skipped.
+///
+/// `ALL` is a constant so that each variant's loops carry no flag (it spilled).
+pub fn gather_flagged<P: FlaggedState + Copy, const ALL: bool>(
+    parts: &mut [P],
+    flags: &mut [bool],
+    anc: &[u32],
+) {
+    #[inline(always)]
+    fn copy<P: FlaggedState + Copy>(
+        parts: &mut [P],
+        flags: &mut [bool],
+        j: usize,
+        a: usize,
+        all: bool,
+    ) {
+        let e = match flags.get(a) {
+            Some(&e) => e,
+            None => return,
+        };
+        if let Some(d) = flags.get_mut(j) {
+            *d = e;
+        }
+        if !(e || all) {
+            return;
+        }
+        if let Some(&s) = parts.get(a) {
+            if let Some(d) = parts.get_mut(j) {
+                d.copy_from(&s, all);
+            }
+        }
+    }
+    for (j, &a) in anc.iter().enumerate() {
+        if a as usize > j {
+            copy(parts, flags, j, a as usize, ALL);
+        }
+    }
+    for (j, &a) in anc.iter().enumerate().rev() {
+        if (a as usize) < j {
+            copy(parts, flags, j, a as usize, ALL);
+        }
+    }
+}
+
 /// Reorders `states` so that `states[j] = old states[ancestors[j]]`, in place and in
 /// O(N), for **sorted** ancestors (what [`resample`] produces).
 ///
@@ -438,5 +557,87 @@ mod tests {
         p.resample(Scheme::Systematic, &mut rng).unwrap();
         assert!(p.states.iter().all(|&s| s == 10.0));
         assert!((p.ess() - 64.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn systematic_with_sum_equals_resample() {
+        // Weights like CRPF's: many equal (absent particles), a few larger, exact zeros.
+        let mut rng = Rng::seed_from_u64(11);
+        for n in [1usize, 2, 7, 64, 1000, 6000] {
+            for trial in 0..20 {
+                let w: Vec<f32> = (0..n)
+                    .map(|i| match (i + trial) % 5 {
+                        0 => rng.uniform(),
+                        1 => 0.0,
+                        _ => 1e-3 * (1 + trial % 3) as f32,
+                    })
+                    .collect();
+                let mut sum = KahanSum::new();
+                for &x in &w {
+                    sum.add(x);
+                }
+                let mut a = std::vec![0u32; n];
+                let mut b = std::vec![0u32; n];
+                let mut scratch = std::vec![0.0f32; n];
+                let mut r1 = rng.clone();
+                let mut r2 = rng.clone();
+                let ok1 = resample(Scheme::Systematic, &w, &mut a, &mut r1).is_ok();
+                let ok2 = systematic_with_sum(&w, sum.value(), &mut scratch, &mut b, &mut r2);
+                assert_eq!(ok1, ok2, "n {n} trial {trial}");
+                if ok1 {
+                    assert_eq!(a, b, "n {n} trial {trial}");
+                }
+                assert_eq!(r1, r2);
+                rng.next_u32();
+            }
+        }
+        // All zero: both refuse, nothing drawn.
+        let w = [0.0f32; 4];
+        let mut r = Rng::seed_from_u64(1);
+        let before = r.clone();
+        assert!(!systematic_with_sum(
+            &w,
+            0.0,
+            &mut [0.0; 4],
+            &mut [0; 4],
+            &mut r
+        ));
+        assert_eq!(r, before);
+    }
+
+    #[test]
+    fn gather_flagged_equals_gather() {
+        #[derive(Debug, Clone, Copy, PartialEq, Default)]
+        struct S([f32; 2]);
+        impl FlaggedState for S {
+            fn copy_from(&mut self, from: &Self, _all: bool) {
+                *self = *from;
+            }
+        }
+        let mut rng = Rng::seed_from_u64(5);
+        for n in [1usize, 2, 9, 300] {
+            let w: Vec<f32> = (0..n).map(|_| rng.uniform()).collect();
+            let mut anc = std::vec![0u32; n];
+            resample(Scheme::Systematic, &w, &mut anc, &mut rng).unwrap();
+            let states: Vec<S> = (0..n).map(|i| S([i as f32, -(i as f32)])).collect();
+            let flags: Vec<bool> = (0..n).map(|i| i % 3 != 0).collect();
+            let mut want_s = states.clone();
+            let mut want_f = flags.clone();
+            gather_in_place(&mut want_s, &anc).unwrap();
+            gather_in_place(&mut want_f, &anc).unwrap();
+            // ALL: states and flags as gather_in_place.
+            let (mut s, mut f) = (states.clone(), flags.clone());
+            gather_flagged::<S, true>(&mut s, &mut f, &anc);
+            assert_eq!((&s, &f), (&want_s, &want_f), "n {n}");
+            // Not ALL: the flags, and the states where the flag is set.
+            let (mut s, mut f) = (states.clone(), flags.clone());
+            gather_flagged::<S, false>(&mut s, &mut f, &anc);
+            assert_eq!(f, want_f);
+            for j in 0..n {
+                if f[j] {
+                    assert_eq!(s[j], want_s[j], "n {n} j {j}");
+                }
+            }
+        }
     }
 }

@@ -10,6 +10,7 @@ use faint_core::detect::Detector;
 use faint_core::detect::hough::{MhtConfig, MhtTbd};
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
+use faint_core::scene;
 
 use crate::harness::{check, measure, row, Measurement, Static};
 
@@ -37,19 +38,11 @@ fn target(i: usize, s: usize) -> (f32, f32) {
 }
 
 fn fill(rng: &mut Rng, s: usize, buf: &mut [Plot; P]) -> usize {
-    let mut n = 0;
-    for _ in 0..LAMBDA {
-        buf[n] = Plot::new(
-            1.0,
-            rng.uniform_range(0.0, 6000.0),
-            rng.uniform_range(0.0, 6000.0),
-        );
-        n += 1;
-    }
+    let mut n = scene::clutter_plots(rng, [0.0, 6000.0, 0.0, 6000.0], &mut buf[..LAMBDA], |_| 1.0);
     for i in 0..5 {
-        if rng.bernoulli(0.85) {
-            let (x, y) = target(i, s);
-            buf[n] = Plot::new(9.0, x + 5.0 * rng.normal(), y + 5.0 * rng.normal());
+        let (x, y) = target(i, s);
+        if let Some((x, y)) = scene::detection(rng, 0.85, x, y, 5.0) {
+            buf[n] = Plot::new(9.0, x, y);
             n += 1;
         }
     }

@@ -7,19 +7,12 @@ use faint_core::detect::hough::{ClassicHough, ClassicHoughConfig, MhtConfig, Mht
 use faint_core::detect::Detector;
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
+use faint_core::scene;
 
 type Det = MhtTbd<48, 10, 32, 30, 4>;
 
 fn scan(rng: &mut Rng, s: usize, out: &mut [Plot; 48]) -> usize {
-    let mut n = 0;
-    for _ in 0..40 {
-        out[n] = Plot::new(
-            1.0,
-            rng.uniform_range(0.0, 1500.0),
-            rng.uniform_range(0.0, 1500.0),
-        );
-        n += 1;
-    }
+    let n = scene::clutter_plots(rng, [0.0, 1500.0, 0.0, 1500.0], &mut out[..40], |_| 1.0);
     let t = s as f32;
     out[n] = Plot::new(5.0, 200.0 + 60.0 * t + 4.0 * rng.normal(), 300.0 + 40.0 * t);
     out[n + 1] = Plot::new(

@@ -131,22 +131,8 @@ pub fn cube(g: &CubeGeometry, k: usize, rng: &mut Rng, out: &mut [f32]) {
             }
         });
     }
-    let cells = &mut cells[..nc];
-    cells.sort_unstable_by_key(|e| e.0);
-    let sd = math::sqrt(NOISE_VAR);
-    let mut i = 0;
-    while i < cells.len() {
-        let idx = cells[i].0;
-        let mut s = Complex32::new(0.0, 0.0);
-        while i < cells.len() && cells[i].0 == idx {
-            s += cells[i].1;
-            i += 1;
-        }
-        let n = Complex32::new(sd * rng.normal(), sd * rng.normal());
-        if let Some(z) = out.get_mut(idx) {
-            *z = (s + n).norm_sqr();
-        }
-    }
+    let mut order = [0u32; MAX_TARGETS * 27];
+    faint_core::scene::cube_returns(out, &mut cells[..nc], &mut order, NOISE_VAR, rng);
 }
 
 pub use faint_core::detect::phd::Variant;

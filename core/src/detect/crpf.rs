@@ -24,7 +24,7 @@
 //!
 //! Implementation notes:
 //! - The existence draws of eq. 9 for `E_{k-1} = 0` particles are made by geometric
-//!   skipping (`Births`): in each pass the number of absent particles before the next
+//!   skipping ([`BirthGaps`]): in each pass the number of absent particles before the next
 //!   birth is drawn once (exactly geometric with parameter `Pb`), so an absent particle
 //!   that stays absent costs no draw. Present particles draw their death as before.
 //! - All weights are computed in the log domain: `ln mu_i = -q ln R_i` (eq. 4) with
@@ -44,7 +44,7 @@
 //!   (first bin, row), and `||h||^2 = amp^2 (H0 + frac (H1 + frac H2))` (see
 //!   [`DopplerModel::project_cached`](crate::model::doppler::DopplerModel::project_cached));
 //!   the same sums up to rounding (relative difference below 4e-6, test `crpf_model`).
-//!   Births, spread over the band, project directly.
+//!   BirthGaps, spread over the band, project directly.
 //! - `Sigma = diag(jitter_std^2)` (empirical, [`CrpfConfig::jitter_std`]).
 //! - The parent's `<z_{k-1}, h_{k-1}>` and `||h_{k-1}||^2` needed by the gate were
 //!   computed for its own cost one frame earlier; each particle stores them, so the gate
@@ -62,11 +62,13 @@
 //! [`Detector::configure`](crate::detect::Detector::configure).
 
 use crate::detect::{Detection, Detector, ScoreKind, Validate};
+use crate::existence::{BirthGaps, ExistenceDraw};
 use crate::math::{self, KahanSum};
 use crate::model::doppler::{
-    check_frame, DopplerReport, Model, ModelConfig, ProjectionCache, DOPPLER_STATE, MAX_BINS,
+    check_frame, DopplerReport, Model, ModelConfig, Motion, ProjectionCache, DOPPLER_STATE,
+    MAX_BINS,
 };
-use crate::particles::{resample, Scheme};
+use crate::particles::{gather_flagged, resample, systematic_with_sum, FlaggedState, Scheme};
 use crate::rng::Rng;
 use crate::{Complex32, Error, Result};
 
@@ -180,242 +182,22 @@ struct Particle {
     hh: f32,
 }
 
-/// Systematic resampling of `anc.len()` ancestors, the same result and the same single
-/// draw as [`resample`]`(Scheme::Systematic, w, anc, rng)` for weights in `[0, 1]`, in
-/// fewer passes: `sum` is the caller's compensated sum of `w` (a [`KahanSum`] in index
-/// order, what `resample` computes), the quantised weights `q_i = floor(w_i 2^31 / sum)`
-/// are computed once into `scratch` (as bits) instead of twice, and the checks of
-/// `resample` for negative or non-finite weights are not repeated (a non-finite weight
-/// makes `sum` non-finite). Returns `false`, with nothing drawn, where `resample` errs.
-fn systematic(w: &[f32], sum: f32, scratch: &mut [f32], anc: &mut [u32], rng: &mut Rng) -> bool {
-    if !(sum > 0.0 && sum.is_finite()) || w.is_empty() || w.len() != scratch.len() {
-        return false;
-    }
-    let mut scale = 2_147_483_648.0f32 / sum;
-    if !scale.is_finite() {
-        return false;
-    }
-    scale *= 1.0 - 4.0 * f32::EPSILON;
-    let mut total = 0u64;
-    for (q, &x) in scratch.iter_mut().zip(w.iter()) {
-        // As `particles::quantise`: x * scale <= 2^31 (1 + eps) fits a u32.
-        let v = (x * scale) as u32;
-        *q = f32::from_bits(v);
-        total += v as u64;
-    }
-    if total == 0 {
-        return false;
-    }
-    // Position j is (a + j T) / M; j goes to the first i with a + j T < M C_i. The walk
-    // keeps `gap = M C_i - (a + j T)` (exact in i64: both terms are below 2^45 for
-    // M < 2^13, and below 2^63 for any M < 2^31) and advances i while `gap <= 0`.
-    let m = anc.len() as u64;
-    let a = (rng.next_u32() as u64 * total) >> 32;
-    let mut qs = scratch.iter().map(|q| q.to_bits() as u64);
-    let mut i = 0u32;
-    let mut gap = (m * qs.next().unwrap_or(0)) as i64 - a as i64;
-    let step_value = total as i64;
-    // Read from memory by one `ldrd` per slot (opaque reference) instead of being
-    // spilled and reloaded word by word.
-    let step = core::hint::black_box(&step_value);
-    for slot in anc.iter_mut() {
-        while gap <= 0 {
-            match qs.next() {
-                Some(q) => {
-                    i += 1;
-                    gap += (m * q) as i64;
-                }
-                None => break,
-            }
-        }
-        *slot = i;
-        gap -= *step;
-    }
-    true
-}
-
-/// `parts[j] = old parts[anc[j]]`, `exists[j] = old exists[anc[j]]` in place for sorted
-/// ancestors (what [`resample`] produces), like
-/// [`gather_in_place`](crate::particles::gather_in_place) but copying field by field (a
-/// whole-struct copy inside one slice compiles to a `memmove` call per particle on the
-/// M4) and, unless `ALL` (`lambda > 0`), copying the state only of `E = 1` particles (with `lambda = 0`
-/// an absent particle's state is never read). Same two passes (ascending for `a > j`,
-/// descending for `a < j`).
-///
-/// `ALL` is a constant so that each variant's loops carry no flag (it spilled).
-fn gather_particles<const ALL: bool>(parts: &mut [Particle], exists: &mut [bool], anc: &[u32]) {
-    let all = ALL;
+impl FlaggedState for Particle {
+    /// Field by field (a whole-struct copy inside one slice compiles to a `memmove` call
+    /// per particle on the M4); the parent cost only when `lambda > 0` (`all`), the only
+    /// case that reads it.
     #[inline(always)]
-    fn copy(parts: &mut [Particle], exists: &mut [bool], j: usize, a: usize, all: bool) {
-        let e = match exists.get(a) {
-            Some(&e) => e,
-            None => return,
-        };
-        if let Some(d) = exists.get_mut(j) {
-            *d = e;
+    fn copy_from(&mut self, s: &Self, all: bool) {
+        self.x[0] = s.x[0];
+        self.x[1] = s.x[1];
+        self.x[2] = s.x[2];
+        if all {
+            self.log_c = s.log_c;
         }
-        if !(e || all) {
-            return;
-        }
-        if let Some(&s) = parts.get(a) {
-            let (x, log_c, zh, hh) = (s.x, s.log_c, s.zh, s.hh);
-            if let Some(d) = parts.get_mut(j) {
-                d.x[0] = x[0];
-                d.x[1] = x[1];
-                d.x[2] = x[2];
-                if all {
-                    // The parent cost is read only when lambda > 0.
-                    d.log_c = log_c;
-                }
-                d.zh.re = zh.re;
-                d.zh.im = zh.im;
-                d.hh = hh;
-            }
-        }
+        self.zh.re = s.zh.re;
+        self.zh.im = s.zh.im;
+        self.hh = s.hh;
     }
-    for (j, &a) in anc.iter().enumerate() {
-        if a as usize > j {
-            copy(parts, exists, j, a as usize, all);
-        }
-    }
-    for (j, &a) in anc.iter().enumerate().rev() {
-        if (a as usize) < j {
-            copy(parts, exists, j, a as usize, all);
-        }
-    }
-}
-
-/// The existence draw of eq. 9 in integers, bit-identical to
-/// [`ExistenceMarkov::sample`](crate::existence::ExistenceMarkov::sample): that draws
-/// `u = (x >> 8) 2^-24` from one `u32` `x` and compares `u < p`; `p 2^24` is exact in
-/// `f32`, so `u < p` is `(x >> 8) < ceil(p 2^24)` for the whole number `x >> 8`.
-#[derive(Debug, Clone, Copy)]
-struct ExistenceDraw {
-    /// `[ceil(Pb 2^24), ceil(Pd 2^24)]`, indexed by `E_{k-1}`.
-    thr: [u32; 2],
-}
-
-impl ExistenceDraw {
-    fn new(chain: &crate::existence::ExistenceMarkov) -> Self {
-        // p in [0, 1] (validated by the chain), so p 2^24 in [0, 2^24] is exact.
-        let ceil = |p: f32| {
-            let t = p * 16_777_216.0;
-            let f = t as u32;
-            if (f as f32) < t {
-                f + 1
-            } else {
-                f
-            }
-        };
-        Self {
-            thr: [ceil(chain.birth()), ceil(chain.death())],
-        }
-    }
-
-    /// `E_k` given `E_{k-1} = existed`, from one draw: the flag flips (birth or death)
-    /// when the draw falls below the row's threshold.
-    #[inline(always)]
-    fn next(&self, existed: bool, rng: &mut Rng) -> bool {
-        let u = rng.next_u32() >> 8;
-        let thr = self.thr[existed as usize];
-        existed != (u < thr)
-    }
-}
-
-/// The births of eq. 9 among absent particles, drawn by geometric skipping: in one pass
-/// over the particles every `E_{k-1} = 0` particle is born independently with
-/// probability `Pb`, so the number of absent particles that stay absent before the next
-/// birth is geometric, `P(G >= g) = (1 - Pb)^g`, and one draw of `G` per birth replaces
-/// one draw per absent particle. [`gap`](Self::gap) draws `G` by inversion of its
-/// distribution function on one `u32`: `G = g` for `T_{g-1} <= u < T_g`,
-/// `T_g = 2^32 (1 - (1 - Pb)^(g+1))` (a table of 32 entries, binary search); a draw
-/// beyond the table (probability `(1 - Pb)^32`, 0.19 for `Pb = 0.05`) adds 32 and draws
-/// again, which is exact because the geometric law is memoryless. When `(1 - Pb)^32 > 1/2`
-/// (`Pb` below about 0.021) the table would loop too often, and
-/// `G = floor(ln U / ln(1 - Pb))` (`U` uniform on `(0, 1]`, 24 bits) is used instead. The
-/// same law as one draw per particle, up to the rounding of `T_g` (`f32`, relative
-/// error below `1e-5`) or the 2^-24 resolution of `U`.
-#[derive(Debug, Clone, Copy)]
-struct Births {
-    /// `T_g`, `g = 0..32`.
-    thr: [u32; 32],
-    /// `1 / ln(1 - Pb)` for the logarithmic fallback.
-    scale: f32,
-    mode: BirthMode,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum BirthMode {
-    /// `Pb = 0`: no absent particle is ever born.
-    Never,
-    /// `Pb = 1`: every absent particle is born.
-    Always,
-    Table,
-    Log,
-}
-
-impl Births {
-    fn new(chain: &crate::existence::ExistenceMarkov) -> Self {
-        let pb = chain.birth();
-        let q = 1.0 - pb;
-        let mut thr = [0u32; 32];
-        let mut tail = 1.0f32;
-        for t in thr.iter_mut() {
-            tail *= q;
-            // P(G <= g) 2^32, saturating at u32::MAX.
-            *t = ((1.0 - tail) * 4_294_967_296.0) as u32;
-        }
-        let mode = if pb <= 0.0 {
-            BirthMode::Never
-        } else if pb >= 1.0 {
-            BirthMode::Always
-        } else if tail > 0.5 {
-            BirthMode::Log
-        } else {
-            BirthMode::Table
-        };
-        Self {
-            thr,
-            scale: 1.0 / math::ln1p(-pb),
-            mode,
-        }
-    }
-
-    /// Absent particles that stay absent before the next birth.
-    #[inline(never)]
-    fn gap(&self, mut rng: Rng) -> (Rng, u32) {
-        match self.mode {
-            BirthMode::Table => {
-                let last = self.thr[31];
-                let mut base = 0u32;
-                loop {
-                    let u = rng.next_u32();
-                    if u < last {
-                        let g = self.thr.partition_point(|&t| t <= u) as u32;
-                        return (rng, base.saturating_add(g));
-                    }
-                    base = base.saturating_add(32);
-                }
-            }
-            BirthMode::Log => {
-                // ln U <= 0 and scale < 0: a non-negative product (saturating conversion).
-                let g = (math::ln(rng.uniform_open0()) * self.scale) as u32;
-                (rng, g)
-            }
-            BirthMode::Never => (rng, u32::MAX),
-            BirthMode::Always => (rng, 0),
-        }
-    }
-}
-
-/// `ln(e^a + e^b)`, exact for `-inf` arguments.
-#[inline]
-fn log_add_exp(a: f32, b: f32) -> f32 {
-    let (hi, lo) = if a > b { (a, b) } else { (b, a) };
-    if lo == f32::NEG_INFINITY {
-        return hi;
-    }
-    hi + math::ln1p(math::exp(lo - hi))
 }
 
 /// `ln C` of a squared residual `d2`, with forgetting of the parent cost (eq. 11).
@@ -423,7 +205,7 @@ fn log_add_exp(a: f32, b: f32) -> f32 {
 fn log_cost(cfg: &CrpfConfig, d2: f32, parent_log_c: f32, ln_lambda: f32) -> f32 {
     let c = 0.5 * cfg.p * math::ln(d2);
     if cfg.lambda > 0.0 {
-        log_add_exp(ln_lambda + parent_log_c, c)
+        math::log_add_exp(ln_lambda + parent_log_c, c)
     } else {
         c
     }
@@ -475,7 +257,7 @@ fn int_exponent(cfg: &CrpfConfig) -> Option<u32> {
 #[inline(always)]
 fn predicted_existence(
     draw: &ExistenceDraw,
-    births: &Births,
+    births: &BirthGaps,
     e: bool,
     rng: &mut Rng,
     left: &mut u32,
@@ -503,7 +285,7 @@ struct UpdateCtx<'a> {
     ln_lambda: f32,
     zz_floor: f32,
     draw: &'a ExistenceDraw,
-    births: &'a Births,
+    births: &'a BirthGaps,
 }
 
 /// Step (4) over all particles, from birth gap `left`. Flags and states zipped: no index
@@ -687,7 +469,7 @@ fn risk_present(
     } else {
         model.prior.sample(&mut rng)
     };
-    // Births land anywhere in the band: projected directly (a cache entry would be used
+    // BirthGaps land anywhere in the band: projected directly (a cache entry would be used
     // once).
     let pr = if existed {
         model.obs.project_cached::<false>(cache, z, xp[0], xp[2])
@@ -712,7 +494,7 @@ fn risk_pass(
     parts: &[Particle],
     out: &mut [f32],
     rng_out: &mut Rng,
-    births: &Births,
+    births: &BirthGaps,
     cache: &mut ProjectionCache,
 ) -> f32 {
     let zz_floor = zz.max(f32::MIN_POSITIVE);
@@ -766,7 +548,7 @@ struct RiskCtx<'a> {
     zz: f32,
     zz_floor: f32,
     draw: &'a ExistenceDraw,
-    births: &'a Births,
+    births: &'a BirthGaps,
 }
 
 /// What the risk pass accumulates out of line.
@@ -822,7 +604,7 @@ pub struct CrpfTbd<const N: usize> {
     /// `q p / 2` when the ln-free weight path applies.
     int_exponent: Option<u32>,
     /// The birth-gap sampler of the model's existence chain.
-    births: Births,
+    births: BirthGaps,
     /// Per-frame projection sums.
     cache: ProjectionCache,
     /// The last frame's report.
@@ -840,7 +622,7 @@ impl<const N: usize> CrpfTbd<N> {
         }
         let model = cfg.build()?;
         let int_exponent = int_exponent(&cfg);
-        let births = Births::new(&model.chain);
+        let births = BirthGaps::new(&model.chain);
         let mut s = Self {
             cfg,
             model,
@@ -930,7 +712,7 @@ impl<const N: usize> CrpfTbd<N> {
             // Degenerate weights cannot occur (risks are floored and finite, so every
             // w_i is in [0, 1] and the best is 1); if they did, the particles are kept as
             // they are (identity resampling), as with `resample`'s errors below.
-            if systematic(
+            if systematic_with_sum(
                 &self.w,
                 sum.value(),
                 &mut self.log_w,
@@ -939,9 +721,9 @@ impl<const N: usize> CrpfTbd<N> {
             ) {
                 let all = self.cfg.lambda > 0.0;
                 if all {
-                    gather_particles::<true>(&mut self.parts, &mut self.exists, &self.anc);
+                    gather_flagged::<Particle, true>(&mut self.parts, &mut self.exists, &self.anc);
                 } else {
-                    gather_particles::<false>(&mut self.parts, &mut self.exists, &self.anc);
+                    gather_flagged::<Particle, false>(&mut self.parts, &mut self.exists, &self.anc);
                 }
             }
             return;
@@ -951,7 +733,7 @@ impl<const N: usize> CrpfTbd<N> {
             for (i, lr) in self.log_w.iter_mut().enumerate() {
                 let half = 0.5 * self.cfg.p * math::ln(*lr);
                 *lr = if self.cfg.lambda > 0.0 {
-                    log_add_exp(ln_lambda + self.parts[i].log_c, half)
+                    math::log_add_exp(ln_lambda + self.parts[i].log_c, half)
                 } else {
                     half
                 };
@@ -976,7 +758,7 @@ impl<const N: usize> CrpfTbd<N> {
                         } else {
                             f32::NEG_INFINITY
                         };
-                        *lr = -q * log_add_exp(l_diff, lg);
+                        *lr = -q * math::log_add_exp(l_diff, lg);
                     }
                 }
             }
@@ -987,9 +769,9 @@ impl<const N: usize> CrpfTbd<N> {
         if ok && resample(Scheme::Systematic, &self.w, &mut self.anc, &mut self.rng).is_ok() {
             let all = self.cfg.lambda > 0.0;
             if all {
-                gather_particles::<true>(&mut self.parts, &mut self.exists, &self.anc);
+                gather_flagged::<Particle, true>(&mut self.parts, &mut self.exists, &self.anc);
             } else {
-                gather_particles::<false>(&mut self.parts, &mut self.exists, &self.anc);
+                gather_flagged::<Particle, false>(&mut self.parts, &mut self.exists, &self.anc);
             }
         }
     }
@@ -1078,7 +860,7 @@ impl<const N: usize> CrpfTbd<N> {
         // Doppler is averaged relative to the min-cost particle so the wrap at the band
         // edge does not split the mean.
         let ref_fd = self.parts[a].x[0];
-        let width = self.model.motion.band.1 - self.model.motion.band.0;
+        let width = self.model.motion.band_width();
         // One loop per weight form (the form is not re-tested per particle).
         let (s, acc) = match n {
             Some(4) => self.weighted_sums(live, ref_fd, width, |c| powi(best / c, 4)),
@@ -1108,13 +890,7 @@ impl<const N: usize> CrpfTbd<N> {
         let mut acc = [0.0f32; 3];
         for p in live.iter().filter_map(|&i| self.parts.get(i as usize)) {
             let w = weight(p.log_c);
-            let mut dfd = p.x[0] - ref_fd;
-            if dfd > 0.5 * width {
-                dfd -= width;
-            } else if dfd < -0.5 * width {
-                dfd += width;
-            }
-            acc[0] += w * dfd;
+            acc[0] += w * Motion::wrap_offset(p.x[0], ref_fd, width);
             acc[1] += w * p.x[1];
             acc[2] += w * p.x[2];
             s += w;
@@ -1142,7 +918,7 @@ impl<const N: usize> Detector for CrpfTbd<N> {
         }
         let model = cfg.build()?;
         self.int_exponent = int_exponent(cfg);
-        self.births = Births::new(&model.chain);
+        self.births = BirthGaps::new(&model.chain);
         self.cfg = *cfg;
         self.model = model;
         self.init_from(seed);
@@ -1175,95 +951,5 @@ impl<const N: usize> Detector for CrpfTbd<N> {
         } else {
             None
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use std::vec::Vec;
-
-    #[test]
-    fn birth_gaps_are_geometric() {
-        // Births by geometric skipping against the law of one Bernoulli(Pb) draw per
-        // absent particle: over 400 000 absent particles the birth rate and the law of
-        // the gap (P(G = 0) = Pb, P(G >= 20) = (1 - Pb)^20) must match within 5 binomial
-        // standard deviations (sd of the rate 3.4e-4 at Pb = 0.05), i.e. an error of
-        // 1.7e-3 in the rate fails.
-        // 0.01 takes the logarithmic path, 0.05 and 0.3 the table.
-        for pb in [0.01f32, 0.05, 0.3] {
-            let chain = crate::existence::ExistenceMarkov::new(pb, 0.05).unwrap();
-            let b = Births::new(&chain);
-            let mut rng = Rng::seed_from_u64(3);
-            let (mut births, mut absent) = (0u64, 0u64);
-            let (mut zero, mut long, mut gaps) = (0u64, 0u64, 0u64);
-            while absent < 400_000 {
-                let (r, g) = b.gap(rng);
-                rng = r;
-                gaps += 1;
-                zero += (g == 0) as u64;
-                long += (g >= 20) as u64;
-                absent += g as u64 + 1;
-                births += 1;
-            }
-            let p = pb as f64;
-            let check = |got: f64, want: f64, n: u64| {
-                let sd = (want * (1.0 - want) / n as f64).sqrt();
-                assert!((got - want).abs() < 5.0 * sd, "pb {pb}: {got} vs {want}");
-            };
-            check(births as f64 / absent as f64, p, absent);
-            check(zero as f64 / gaps as f64, p, gaps);
-            check(long as f64 / gaps as f64, (1.0 - p).powi(20), gaps);
-        }
-        // Pb = 0: never born; Pb = 1: always born.
-        let never = Births::new(&crate::existence::ExistenceMarkov::new(0.0, 0.05).unwrap());
-        assert_eq!(never.gap(Rng::seed_from_u64(1)).1, u32::MAX);
-        let always = Births::new(&crate::existence::ExistenceMarkov::new(1.0, 0.05).unwrap());
-        let mut rng = Rng::seed_from_u64(1);
-        for _ in 0..1000 {
-            let (r, g) = always.gap(rng);
-            rng = r;
-            assert_eq!(g, 0);
-        }
-    }
-
-    #[test]
-    fn fused_systematic_equals_resample() {
-        // Weights like CRPF's: many equal (absent particles), a few larger, exact zeros.
-        let mut rng = Rng::seed_from_u64(11);
-        for n in [1usize, 2, 7, 64, 1000, 6000] {
-            for trial in 0..20 {
-                let w: Vec<f32> = (0..n)
-                    .map(|i| match (i + trial) % 5 {
-                        0 => rng.uniform(),
-                        1 => 0.0,
-                        _ => 1e-3 * (1 + trial % 3) as f32,
-                    })
-                    .collect();
-                let mut sum = KahanSum::new();
-                for &x in &w {
-                    sum.add(x);
-                }
-                let mut a = std::vec![0u32; n];
-                let mut b = std::vec![0u32; n];
-                let mut scratch = std::vec![0.0f32; n];
-                let mut r1 = rng.clone();
-                let mut r2 = rng.clone();
-                let ok1 = resample(Scheme::Systematic, &w, &mut a, &mut r1).is_ok();
-                let ok2 = systematic(&w, sum.value(), &mut scratch, &mut b, &mut r2);
-                assert_eq!(ok1, ok2, "n {n} trial {trial}");
-                if ok1 {
-                    assert_eq!(a, b, "n {n} trial {trial}");
-                }
-                assert_eq!(r1, r2);
-                rng.next_u32();
-            }
-        }
-        // All zero: both refuse, nothing drawn.
-        let w = [0.0f32; 4];
-        let mut r = Rng::seed_from_u64(1);
-        let before = r.clone();
-        assert!(!systematic(&w, 0.0, &mut [0.0; 4], &mut [0; 4], &mut r));
-        assert_eq!(r, before);
     }
 }

@@ -14,7 +14,7 @@
 
 use crate::detect::Validate;
 use crate::math;
-use crate::model::doppler::{check_frame, DopplerReport, Model, ModelConfig};
+use crate::model::doppler::{check_frame, DopplerReport, Model, ModelConfig, Motion};
 use crate::particles::{gather_in_place, resample, Scheme};
 use crate::rng::Rng;
 use crate::{Complex32, Error, Result};
@@ -92,16 +92,11 @@ fn weighted_mean(
     if best <= 0.0 {
         return None;
     }
-    let width = model.motion.band.1 - model.motion.band.0;
+    let width = model.motion.band_width();
     let mut s = 0.0f32;
     let mut acc = [0.0f32; 3];
     for (x, w) in xs {
-        let mut d = x[0] - reference;
-        if d > 0.5 * width {
-            d -= width;
-        } else if d < -0.5 * width {
-            d += width;
-        }
+        let d = Motion::wrap_offset(x[0], reference, width);
         acc[0] += w * d;
         acc[1] += w * x[1];
         acc[2] += w * x[2];

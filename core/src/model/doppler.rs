@@ -598,6 +598,29 @@ impl Motion {
         Ok(())
     }
 
+    /// Width of the Doppler band `W` (Hz).
+    #[inline]
+    pub fn band_width(&self) -> f32 {
+        self.band.1 - self.band.0
+    }
+
+    /// The offset `fd - reference` brought into `[-W/2, W/2]` by one band width `width`
+    /// (`W`, from [`band_width`](Self::band_width)): what a weighted Doppler mean
+    /// averages, so that a cloud across the band edge is not split; the mean is then
+    /// `wrap(reference + sum w d / sum w)`. Used by every Doppler-frame detector's
+    /// estimate.
+    #[inline(always)]
+    pub fn wrap_offset(fd: f32, reference: f32, width: f32) -> f32 {
+        let d = fd - reference;
+        if d > 0.5 * width {
+            d - width
+        } else if d < -0.5 * width {
+            d + width
+        } else {
+            d
+        }
+    }
+
     /// Wraps a Doppler into the band.
     #[inline]
     pub fn wrap(&self, fd: f32) -> f32 {

@@ -48,49 +48,86 @@ pub fn line_chart(
     y_label: &str,
     series: &[Series],
 ) -> Result<()> {
-    let path = path.as_ref();
+    chart(path.as_ref(), title, x_label, y_label, series, false)
+}
+
+/// [`line_chart`] with a logarithmic y axis (points with `y <= 0` are left out).
+pub fn line_chart_log_y(
+    path: impl AsRef<Path>,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+) -> Result<()> {
+    chart(path.as_ref(), title, x_label, y_label, series, true)
+}
+
+fn chart(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    log_y: bool,
+) -> Result<()> {
     super::ensure_parent(path)?;
-    let (x0, x1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)))?;
-    let (y0, y1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)))?;
+    let shown = |p: &(f64, f64)| p.0.is_finite() && p.1.is_finite() && (!log_y || p.1 > 0.0);
+    let (x0, x1) = range(
+        series
+            .iter()
+            .flat_map(|s| s.points.iter().filter(|p| shown(p)).map(|p| p.0)),
+    )?;
+    let (y0, y1) = range(
+        series
+            .iter()
+            .flat_map(|s| s.points.iter().filter(|p| shown(p)).map(|p| p.1)),
+    )?;
     let root = SVGBackend::new(path, (900, 600)).into_drawing_area();
     let e = |e: DrawingAreaErrorKind<_>| anyhow!("plotting {}: {e:?}", path.display());
     root.fill(&WHITE).map_err(e)?;
-    let mut chart = ChartBuilder::on(&root)
+    let mut builder = ChartBuilder::on(&root);
+    builder
         .caption(title, ("sans-serif", 22))
         .margin(15)
         .x_label_area_size(45)
-        .y_label_area_size(60)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(e)?;
-    chart
-        .configure_mesh()
-        .x_desc(x_label)
-        .y_desc(y_label)
-        .draw()
-        .map_err(e)?;
-    for (k, s) in series.iter().enumerate() {
-        let col = COLOURS[k % COLOURS.len()];
-        let pts: Vec<(f64, f64)> = s
-            .points
-            .iter()
-            .copied()
-            .filter(|p| p.0.is_finite() && p.1.is_finite())
-            .collect();
-        chart
-            .draw_series(LineSeries::new(pts.clone(), col.stroke_width(2)))
-            .map_err(e)?
-            .label(s.name.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
-        chart
-            .draw_series(pts.iter().map(|&p| Circle::new(p, 3, col.filled())))
-            .map_err(e)?;
+        .y_label_area_size(60);
+    macro_rules! draw {
+        ($chart:expr) => {{
+            let mut chart = $chart.map_err(e)?;
+            chart
+                .configure_mesh()
+                .x_desc(x_label)
+                .y_desc(y_label)
+                .draw()
+                .map_err(e)?;
+            for (k, s) in series.iter().enumerate() {
+                let col = COLOURS[k % COLOURS.len()];
+                let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(|p| shown(p)).collect();
+                chart
+                    .draw_series(LineSeries::new(pts.clone(), col.stroke_width(2)))
+                    .map_err(e)?
+                    .label(s.name.clone())
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
+                    });
+                chart
+                    .draw_series(pts.iter().map(|&p| Circle::new(p, 3, col.filled())))
+                    .map_err(e)?;
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()
+                .map_err(e)?;
+        }};
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(e)?;
+    if log_y {
+        let (lo, hi) = (y0.max(f64::MIN_POSITIVE), y1.max(f64::MIN_POSITIVE));
+        draw!(builder.build_cartesian_2d(x0..x1, (lo * 0.8..hi * 1.25).log_scale()));
+    } else {
+        draw!(builder.build_cartesian_2d(x0..x1, y0..y1));
+    }
     root.present().map_err(e)?;
     Ok(())
 }

@@ -22,12 +22,13 @@ use faint_core::detect::Detector;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::Context as _;
 use faint_core::detect::hough::{
     ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, NO_PLOT,
 };
 
 use crate::analysis::hough_model::{self, CellModel, ChainSource, CompoundModel, ModelParams};
+use crate::io::plot::{self, Series};
+use crate::io::write_csv;
 use crate::scenario::sea_clutter::{Origin, SeaClutter, Trial};
 
 /// Plots per scan capacity (Poisson(398) exceeds 520 with probability ~1e-9).
@@ -531,15 +532,8 @@ pub fn proportion_ci(k: u64, n: u64) -> (f64, f64, f64) {
     (p.p, p.lo, p.hi)
 }
 
-fn write_csv<S: serde::Serialize>(path: &Path, rows: &[S]) -> anyhow::Result<()> {
-    let mut w = csv::Writer::from_path(path).with_context(|| format!("{}", path.display()))?;
-    for r in rows {
-        w.serialize(r)?;
-    }
-    w.flush()?;
-    Ok(())
-}
-
+/// A chart of `(name, points)` series, on a logarithmic y axis if `log_y`; nothing is
+/// drawn when no point can be shown (e.g. every rate 0 on the log axis).
 fn line_chart(
     path: &Path,
     title: &str,
@@ -548,68 +542,22 @@ fn line_chart(
     series: &[(String, Vec<(f64, f64)>)],
     log_y: bool,
 ) -> anyhow::Result<()> {
-    use plotters::prelude::*;
-    let root = SVGBackend::new(path, (800, 560)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let pts = series
-        .iter()
-        .flat_map(|s| s.1.iter())
-        .filter(|p| p.0.is_finite() && p.1.is_finite() && (!log_y || p.1 > 0.0));
-    let (mut x0, mut x1, mut y0, mut y1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for p in pts {
-        x0 = x0.min(p.0);
-        x1 = x1.max(p.0);
-        y0 = y0.min(p.1);
-        y1 = y1.max(p.1);
-    }
-    if !x0.is_finite() {
+    let shown = |p: &(f64, f64)| p.0.is_finite() && p.1.is_finite() && (!log_y || p.1 > 0.0);
+    if !series.iter().any(|s| s.1.iter().any(shown)) {
         return Ok(());
     }
-    if x1 <= x0 {
-        x1 = x0 + 1.0;
-    }
-    if y1 <= y0 {
-        y1 = y0 + 1.0;
-    }
-    let mut b = ChartBuilder::on(&root);
-    b.caption(title, ("sans-serif", 20))
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(70);
-    let colors = [&BLUE, &RED, &GREEN, &MAGENTA, &CYAN, &BLACK, &YELLOW];
-    macro_rules! draw {
-        ($chart:expr) => {{
-            let mut chart = $chart;
-            chart.configure_mesh().x_desc(xl).y_desc(yl).draw()?;
-            for (i, (name, p)) in series.iter().enumerate() {
-                let c = colors[i % colors.len()];
-                let p: Vec<(f64, f64)> =
-                    p.iter().copied().filter(|p| !log_y || p.1 > 0.0).collect();
-                chart
-                    .draw_series(LineSeries::new(p.clone(), c))?
-                    .label(name.as_str())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
-                chart.draw_series(p.iter().map(|&q| Circle::new(q, 3, c.filled())))?;
-            }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .draw()?;
-        }};
-    }
+    let series: Vec<Series> = series
+        .iter()
+        .map(|(name, points)| Series {
+            name: name.clone(),
+            points: points.clone(),
+        })
+        .collect();
     if log_y {
-        draw!(b.build_cartesian_2d(x0..x1, (y0 * 0.5..y1 * 2.0).log_scale())?);
+        plot::line_chart_log_y(path, title, xl, yl, &series)
     } else {
-        draw!(b.build_cartesian_2d(x0..x1, y0.min(0.0)..y1 * 1.05)?);
+        plot::line_chart(path, title, xl, yl, &series)
     }
-    root.present()?;
-    Ok(())
 }
 
 /// Model curves row.

@@ -290,19 +290,8 @@ impl SixTargets {
             self.psf
                 .for_each_cell(&g, &c, |idx, h| cells.push((idx, a * h)));
         }
-        cells.sort_by_key(|e| e.0);
-        let sd = s2.sqrt();
-        let mut i = 0;
-        while i < cells.len() {
-            let idx = cells[i].0;
-            let mut s = Complex32::new(0.0, 0.0);
-            while i < cells.len() && cells[i].0 == idx {
-                s += cells[i].1;
-                i += 1;
-            }
-            let n = Complex32::new(sd * rng.normal(), sd * rng.normal());
-            cube[idx] = (s + n).norm_sqr();
-        }
+        let mut order = vec![0u32; cells.len()];
+        faint_core::scene::cube_returns(cube, &mut cells, &mut order, s2, rng);
     }
 
     /// Filter configuration for `variant`.

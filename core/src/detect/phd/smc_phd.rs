@@ -339,15 +339,6 @@ fn find(parent: &mut [u32], mut r: usize) -> usize {
     r
 }
 
-#[inline]
-fn log_add_exp(a: f32, b: f32) -> f32 {
-    let (hi, lo) = if a > b { (a, b) } else { (b, a) };
-    if lo == f32::NEG_INFINITY {
-        return hi;
-    }
-    hi + math::ln1p(math::exp(lo - hi))
-}
-
 impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N, S, M, K> {
     /// A filter with an empty PHD (the first frame's births populate it).
     /// Errors: invalid config, `J >= N`, more PSO points than `M`, `K == 0`.
@@ -994,7 +985,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         for r in 0..nr {
             if self.parent[r] as usize == r && self.pts[r][0] > f32::NEG_INFINITY {
                 let log_rho = self.pts[r][0] + math::ln(self.pts[r][1]);
-                self.pts[r][1] = log_add_exp(ln_lambda, log_rho);
+                self.pts[r][1] = math::log_add_exp(ln_lambda, log_rho);
             }
         }
         let mut total = KahanSum::new();
