@@ -673,7 +673,7 @@ fn model_figures(out: &Path) -> anyhow::Result<String> {
         &fig4,
         false,
     )?;
-    write_csv(&out.join("model_curves.csv"), &rows)?;
+    write_csv(out.join("model_curves.csv"), &rows)?;
     let mut s = String::from("| lambda | p_ch | p_dh | N_c | gamma_1 (Pfa<=1e-4) | model Pd |\n|---|---|---|---|---|---|\n");
     for lambda in [80.0, 100.0, 164.0, 237.0, 300.0, 316.0, 398.0] {
         let cm = CellModel::new(ModelParams::paper(lambda));
@@ -886,7 +886,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 evaluate_trial(&null_sc, &tr, &mut m, &mut c)
             },
         );
-        write_csv(&args.out.join(format!("trials_lambda{lambda}.csv")), &res)?;
+        write_csv(args.out.join(format!("trials_lambda{lambda}.csv")), &res)?;
         let sum = |f: &dyn Fn(&TrialStats) -> u32| res.iter().map(|t| u64::from(f(t))).sum::<u64>();
         let n_scans = (sc.n_scans * trials) as f64;
         let det = sum(&|t| t.mht_detected);
@@ -1001,10 +1001,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             }),
         });
     }
-    write_csv(&args.out.join("summary.csv"), &summaries)?;
-    write_csv(&args.out.join("null_pfa.csv"), &null_rows)?;
+    write_csv(args.out.join("summary.csv"), &summaries)?;
+    write_csv(args.out.join("null_pfa.csv"), &null_rows)?;
     if !calib_csv.is_empty() {
-        write_csv(&args.out.join("calib.csv"), &calib_csv)?;
+        write_csv(args.out.join("calib.csv"), &calib_csv)?;
     }
     // figures 10-12
     let xs = |f: &dyn Fn(&Summary) -> f64| {
