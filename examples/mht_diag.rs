@@ -13,9 +13,9 @@
 //! residual rule (`MhtConfig::residual`) off.
 use faint_core::detect::Detector;
 use faint_core::rng::Rng;
-use faint_host::analysis::hough_model::{CellModel, ChainSource, CompoundModel};
+use faint_host::analysis::mht::{CellModel, ChainSource, CompoundModel};
 use faint_host::reproduce::mht::{detectors, model_params, thresholds, MATCH_TOL, NR, NT};
-use faint_host::scenario::sea_clutter::{Origin, SeaClutter};
+use faint_host::scenario::mht::{Origin, SeaClutter};
 
 fn false_tracks(a: &[String]) {
     let lambda: f32 = a.get(2).and_then(|s| s.parse().ok()).unwrap_or(164.0);
@@ -142,7 +142,7 @@ fn lost_targets(a: &[String]) {
         .unwrap_or_else(|| thresholds(&sc, 1e-4).0 as u8);
     let n = sc.n_scans;
     let found = |m: &faint_host::reproduce::mht::Mht,
-                 tg: &faint_host::scenario::sea_clutter::TargetTruth| {
+                 tg: &faint_host::scenario::mht::TargetTruth| {
         m.tracks().iter().position(|trk| {
             let (co, si) = (trk.theta.cos(), trk.theta.sin());
             (0..n).all(|s| {

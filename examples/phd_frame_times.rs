@@ -12,7 +12,7 @@
 //! core on a loaded machine is not counted (Linux x86_64 / aarch64 only).
 use faint_core::detect::Detector;
 use faint_core::rng::Rng;
-use faint_host::scenario::six_targets::{HostFilter, SixTargets, Variant};
+use faint_host::scenario::phd::{HostFilter, SixTargets, Variant};
 
 #[repr(C)]
 struct Timespec {

@@ -105,7 +105,7 @@ struct SimulateArgs {
     lambda: Option<f32>,
     /// Background noise (othr).
     #[arg(long, value_enum, default_value = "gaussian")]
-    noise: faint::host::scenario::othr::Noise,
+    noise: faint::host::scenario::crpf::Noise,
 }
 
 #[derive(Subcommand, Debug)]
@@ -115,7 +115,8 @@ enum Reproduce {
     /// MHT-TBD (modified Hough transform) in dense sea clutter, with the classic Hough TBD.
     Mht(faint::host::reproduce::mht::Args),
     /// Pei et al. 2019: PSO-PHD-TBD versus PHD-TBD (Tables 2-4, Fig. 3-5).
-    Psophd(faint::host::reproduce::psophd::Args),
+    #[command(alias = "psophd")]
+    Phd(faint::host::reproduce::phd::Args),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -154,7 +155,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Reproduce(r) => match r {
             Reproduce::Crpf(a) => faint::host::reproduce::crpf::run(&a),
             Reproduce::Mht(a) => faint::host::reproduce::mht::run(&a),
-            Reproduce::Psophd(a) => faint::host::reproduce::psophd::run(&a),
+            Reproduce::Phd(a) => faint::host::reproduce::phd::run(&a),
         },
     }
 }

@@ -3,7 +3,7 @@
 
 use faint::host::montecarlo::set_quiet;
 use faint::host::reproduce::crpf::{parse_grid, run, Args, METHODS};
-use faint::host::scenario::othr::Noise;
+use faint::host::scenario::crpf::Noise;
 
 #[test]
 fn quick_reproduction_writes_every_output() {

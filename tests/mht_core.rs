@@ -2,7 +2,7 @@
 //! target, the classic baseline, quantisers, and bad input.
 #![allow(clippy::needless_range_loop)]
 
-use faint::core::detect::hough::{
+use faint::core::detect::mht::{
     ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, NO_PLOT,
 };
 use faint::core::detect::Detector;

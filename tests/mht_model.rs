@@ -4,12 +4,12 @@
 
 use faint::core::detect::Detector;
 use faint::core::rng::Rng;
-use faint::host::analysis::hough_model::{
-    self, coverage_pmf, lattice_measure, run_value, run_value_pmf, run_value_pmf_brute, CellModel,
-    ChainSource, CompoundModel, ModelParams,
+use faint::host::analysis::mht::{
+    self as model, coverage_pmf, lattice_measure, run_value, run_value_pmf, run_value_pmf_brute,
+    CellModel, ChainSource, CompoundModel, ModelParams,
 };
 use faint::host::reproduce::mht::{detectors, evaluate_trial, model_params};
-use faint::host::scenario::sea_clutter::SeaClutter;
+use faint::host::scenario::mht::SeaClutter;
 
 #[test]
 fn run_value_examples() {
@@ -69,7 +69,7 @@ fn hit_probabilities_are_probabilities_and_monotone() {
     let mut last = (0.0, 0.0);
     for lambda in [10.0, 80.0, 164.0, 237.0, 316.0, 398.0, 1000.0] {
         let mp = ModelParams::paper(lambda);
-        let (pc, pd) = (hough_model::p_ch(&mp), hough_model::p_dh(&mp));
+        let (pc, pd) = (model::p_ch(&mp), model::p_dh(&mp));
         assert!((0.0..=1.0).contains(&pc) && (0.0..=1.0).contains(&pd));
         assert!(pd >= mp.pd0, "clutter can only add hits to a target cell");
         assert!(pc > last.0 && pd > last.1, "both grow with lambda");
@@ -77,8 +77,8 @@ fn hit_probabilities_are_probabilities_and_monotone() {
     }
     // no clutter: the target hits with Pd0, clutter never
     let mp = ModelParams::paper(0.0);
-    assert_eq!(hough_model::p_ch(&mp), 0.0);
-    assert!((hough_model::p_dh(&mp) - 0.85).abs() < 1e-12);
+    assert_eq!(model::p_ch(&mp), 0.0);
+    assert!((model::p_dh(&mp) - 0.85).abs() < 1e-12);
 }
 
 #[test]
@@ -95,12 +95,11 @@ fn grid_pfa_and_pd_are_monotone_in_gamma() {
 #[test]
 fn classic_chord_lengths() {
     let h = 3000.0;
-    assert!((hough_model::chord(0.0, 0.0, h) - 6000.0).abs() < 1e-9);
+    assert!((model::chord(0.0, 0.0, h) - 6000.0).abs() < 1e-9);
     assert!(
-        (hough_model::chord(0.0, std::f64::consts::FRAC_PI_4, h) - 6000.0 * 2f64.sqrt()).abs()
-            < 1e-6
+        (model::chord(0.0, std::f64::consts::FRAC_PI_4, h) - 6000.0 * 2f64.sqrt()).abs() < 1e-6
     );
-    assert_eq!(hough_model::chord(5000.0, 0.3, h), 0.0);
+    assert_eq!(model::chord(5000.0, 0.3, h), 0.0);
 }
 
 #[test]
@@ -143,7 +142,7 @@ fn coverage_dp_matches_closed_form_and_simulation() {
         .map(|_| (0..=n).map(|k| if k == 1 { nu1 } else { 0.0 }).collect())
         .collect();
     let dp = coverage_pmf(n, &nu);
-    let bin = hough_model::binomial_pmf(n, 1.0 - f64::exp(-nu1));
+    let bin = model::binomial_pmf(n, 1.0 - f64::exp(-nu1));
     for (a, b) in dp.iter().zip(&bin) {
         assert!((a - b).abs() < 1e-12);
     }

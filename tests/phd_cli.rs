@@ -1,4 +1,4 @@
-//! `faint reproduce psophd --quick` runs end to end and writes its outputs.
+//! `faint reproduce phd --quick` (and its alias `psophd`) runs end to end and writes its outputs.
 
 use std::process::Command;
 
@@ -6,7 +6,7 @@ use std::process::Command;
 fn reproduce_psophd_quick_writes_tables_and_plots() {
     let dir = std::env::temp_dir().join(format!("faint-psophd-{}", std::process::id()));
     let out = Command::new(env!("CARGO_BIN_EXE_faint"))
-        .args(["--quiet", "reproduce", "psophd", "--quick", "--out"])
+        .args(["--quiet", "reproduce", "phd", "--quick", "--out"])
         .arg(&dir)
         .output()
         .expect("run faint");

@@ -7,7 +7,7 @@
 use core::mem::size_of;
 use faint_core::detect::Detector;
 
-use faint_core::detect::hough::{MhtConfig, MhtTbd};
+use faint_core::detect::mht::{MhtConfig, MhtTbd};
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
 use faint_core::scene;

@@ -3,7 +3,7 @@
 //! detector's peaks on the same scans. Stack use ~14 KiB (the detector lives on the stack).
 
 use crate::{Fold, ERR, SEED};
-use faint_core::detect::hough::{ClassicHough, ClassicHoughConfig, MhtConfig, MhtTbd};
+use faint_core::detect::mht::{ClassicHough, ClassicHoughConfig, MhtConfig, MhtTbd};
 use faint_core::detect::Detector;
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;

@@ -20,9 +20,9 @@ use serde::Serialize;
 
 use crate::io::output::{write_complex_frames, write_plots, write_real_frames};
 use crate::io::write_csv;
-use crate::scenario::othr::{Noise, Othr};
-use crate::scenario::sea_clutter::SeaClutter;
-use crate::scenario::six_targets::SixTargets;
+use crate::scenario::crpf::{Noise, Othr};
+use crate::scenario::mht::SeaClutter;
+use crate::scenario::phd::SixTargets;
 
 /// What to simulate.
 #[derive(Debug, Clone)]

@@ -4,7 +4,7 @@
 
 use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
-use faint::core::detect::hough::MhtConfig;
+use faint::core::detect::mht::MhtConfig;
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint::core::detect::{run, Detector, ScoreKind};
@@ -12,8 +12,8 @@ use faint::core::model::doppler::DopplerReport;
 use faint::core::rng::Rng;
 use faint::core::Complex32;
 use faint::host::reproduce::mht::Mht;
-use faint::host::scenario::othr::{Noise, Othr};
-use faint::host::scenario::sea_clutter::SeaClutter;
+use faint::host::scenario::crpf::{Noise, Othr};
+use faint::host::scenario::mht::SeaClutter;
 
 fn check_doppler<D: Detector<Frame = [Complex32], Report = DopplerReport>>(
     det: &mut D,

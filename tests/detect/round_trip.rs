@@ -5,7 +5,7 @@ use std::path::Path;
 
 use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
-use faint::core::detect::hough::MhtConfig;
+use faint::core::detect::mht::MhtConfig;
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint::core::detect::phd::Variant;
@@ -15,9 +15,9 @@ use faint::core::rng::Rng;
 use faint::host::detect::default_classic;
 use faint::host::reproduce::crpf::run_detector;
 use faint::host::reproduce::mht::{Classic, Mht};
-use faint::host::scenario::othr::{Noise, Othr};
-use faint::host::scenario::sea_clutter::SeaClutter;
-use faint::host::scenario::six_targets::{HostFilter, SixTargets};
+use faint::host::scenario::crpf::{Noise, Othr};
+use faint::host::scenario::mht::SeaClutter;
+use faint::host::scenario::phd::{HostFilter, SixTargets};
 
 use super::{faint, s, temp};
 

@@ -4,13 +4,13 @@
 //! |---|---|---|
 //! | [`crpf`] | CRPF-TBD (Lu, Wang, Zhang 2017) | `[Complex32]`, `m` Doppler bins |
 //! | [`pf_tbd`], [`bernoulli`], [`pf_lrt`] | PF-TBD, JOTT, PF-LRT (its comparators) | `[Complex32]` |
-//! | [`hough`] | MHT-TBD (Bao et al. 2022), classic Hough TBD | `[Plot]`, one scan |
+//! | [`mht`] | MHT-TBD (Bao et al. 2022), classic Hough TBD | `[Plot]`, one scan |
 //! | [`phd`] | SMC-PHD TBD with the PSO step (Pei et al. 2019) | `[f32]`, one power cube |
 pub mod bernoulli;
 pub mod crpf;
 mod gauss_cloud;
-pub mod hough;
 mod interface;
+pub mod mht;
 pub mod pf_lrt;
 pub mod pf_tbd;
 pub mod phd;

@@ -1,2 +1,2 @@
 //! Closed-form detection models.
-pub mod hough_model;
+pub mod mht;

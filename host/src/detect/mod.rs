@@ -22,7 +22,7 @@ use std::time::Instant;
 use anyhow::{anyhow, bail, ensure, Context, Result};
 use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
-use faint_core::detect::hough::{ClassicHoughConfig, MhtConfig};
+use faint_core::detect::mht::{ClassicHoughConfig, MhtConfig};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint_core::detect::phd::{PhdConfig, Variant};
@@ -36,8 +36,8 @@ use serde::{Deserialize, Serialize};
 use crate::io::input::{read_complex_frames, read_plots, read_real_frames, Frames};
 use crate::montecarlo::progress_bar;
 use crate::reproduce::mht::{Classic, Mht};
-use crate::scenario::sea_clutter::SeaClutter;
-use crate::scenario::six_targets::{HostFilter, SixTargets};
+use crate::scenario::mht::SeaClutter;
+use crate::scenario::phd::{HostFilter, SixTargets};
 
 mod output;
 
@@ -298,7 +298,7 @@ fn default_gauss() -> String {
 /// density of 80 plots per scan (28 counts; the reproduction's value at that density).
 pub fn default_classic() -> ClassicHoughConfig {
     let sc = SeaClutter::paper(80.0);
-    let gamma = crate::analysis::hough_model::classic_gamma(
+    let gamma = crate::analysis::mht::classic_gamma(
         f64::from(sc.area[1] - sc.area[0]),
         crate::reproduce::mht::NR,
         crate::reproduce::mht::NT,

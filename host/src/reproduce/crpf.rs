@@ -24,7 +24,7 @@ use serde::Serialize;
 
 use crate::io::{self, plot};
 use crate::montecarlo::run_trials;
-use crate::scenario::othr::{Noise, Othr, Run};
+use crate::scenario::crpf::{Noise, Othr, Run};
 use crate::stats::detection::{
     detection_rate, snr_at_pd, threshold_at_pfa, PdPoint, Proportion, Threshold,
 };

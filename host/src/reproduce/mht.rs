@@ -22,14 +22,14 @@ use faint_core::detect::Detector;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
-use faint_core::detect::hough::{
+use faint_core::detect::mht::{
     ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, NO_PLOT,
 };
 
-use crate::analysis::hough_model::{self, CellModel, ChainSource, CompoundModel, ModelParams};
+use crate::analysis::mht::{self as model, CellModel, ChainSource, CompoundModel, ModelParams};
 use crate::io::plot::{self, Series};
 use crate::io::write_csv;
-use crate::scenario::sea_clutter::{Origin, SeaClutter, Trial};
+use crate::scenario::mht::{Origin, SeaClutter, Trial};
 
 /// Plots per scan capacity (Poisson(398) exceeds 520 with probability ~1e-9).
 pub const P: usize = 640;
@@ -340,7 +340,7 @@ fn line_matches(theta: f32, c: f32, trial: &Trial, i: usize, t_scan: f32) -> boo
 }
 
 fn max_count<const R: usize, const A: usize>(
-    acc: &faint_core::detect::hough::Accumulator<R, A>,
+    acc: &faint_core::detect::mht::Accumulator<R, A>,
 ) -> u8 {
     let mut m = 0;
     for a in 0..A {
@@ -500,7 +500,7 @@ pub fn thresholds(sc: &SeaClutter, pfa: f64) -> (usize, usize) {
 pub fn thresholds_with(sc: &SeaClutter, pfa: f64, choice: ModelChoice) -> (usize, usize) {
     let mp = model_params(sc);
     let g1 = GridModel::new(mp, choice).gamma_for_pfa(pfa);
-    let gc = hough_model::classic_gamma(
+    let gc = model::classic_gamma(
         f64::from(sc.area[1] - sc.area[0]),
         NR,
         NT,
@@ -906,7 +906,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         // would count a plot once per cell it shares; the model's number of clutter
         // tracks times their mean length, per scan:
         let after_model =
-            cm.n_c * (m0 / hough_model::tail(&cm.p0_raw, 1).max(1e-300)) / sc.n_scans as f64;
+            cm.n_c * (m0 / model::tail(&cm.p0_raw, 1).max(1e-300)) / sc.n_scans as f64;
         let nhit = nres
             .iter()
             .filter(|t| usize::from(t.mht_max_count) >= g1)

@@ -4,4 +4,4 @@
 
 pub mod crpf;
 pub mod mht;
-pub mod psophd;
+pub mod phd;

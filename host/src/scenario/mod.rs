@@ -1,11 +1,13 @@
-//! Scenario presets, one module per paper's scene. A preset is data: a struct holding
-//! the paper's values and the documented choices for what the paper leaves open.
+//! Scenario presets, one module per detector family, named like the family (the preset
+//! keeps the scene's name on the CLI): [`crpf`] holds `othr`, [`mht`] `sea-clutter`,
+//! [`phd`] `six-targets`. A preset is data: a struct holding the paper's values and the
+//! documented choices for what the paper leaves open.
 
 use anyhow::{bail, Result};
 
-pub mod othr;
-pub mod sea_clutter;
-pub mod six_targets;
+pub mod crpf;
+pub mod mht;
+pub mod phd;
 
 /// `(name, one-line description, preset as JSON)` of every built-in scenario.
 type Entry = (&'static str, &'static str, fn() -> serde_json::Value);
@@ -13,15 +15,15 @@ type Entry = (&'static str, &'static str, fn() -> serde_json::Value);
 const CATALOGUE: &[Entry] = &[(
     "othr",
     "sky-wave OTHR, one range cell, Doppler-manoeuvring target, K = m = 32 (Lu et al. 2017)",
-    othr::describe,
+    crpf::describe,
 ), (
     "sea-clutter",
     "MHT-TBD (Bao et al. 2022): 6 km x 6 km sea surface, 5 CV targets, Poisson clutter (shown at lambda = 398)",
-    || serde_json::to_value(sea_clutter::SeaClutter::paper(398.0)).unwrap_or_default(),
+    || serde_json::to_value(mht::SeaClutter::paper(398.0)).unwrap_or_default(),
 ), (
     "six-targets",
     "Pei et al. 2019 PSO-PHD-TBD: six CV targets, range x Doppler x azimuth power cube, 40 frames",
-    six_targets::SixTargets::describe,
+    phd::SixTargets::describe,
 )];
 
 /// Names and descriptions of the built-in scenarios.

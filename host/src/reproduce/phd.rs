@@ -1,4 +1,4 @@
-//! `faint reproduce psophd`: Pei et al. 2019 (PSO-PHD-TBD), Fig. 3-5 and Tables 2-4.
+//! `faint reproduce phd` (alias `psophd`): Pei et al. 2019 (PSO-PHD-TBD), Fig. 3-5 and Tables 2-4.
 //!
 //! Per SNR and Monte Carlo run, one truth and one sequence of 40 power cubes of the
 //! `six-targets` preset; the three algorithms (PHD-TBD, PSO-PHD-TBD with K-means,
@@ -19,7 +19,7 @@ use serde::Serialize;
 
 use crate::io::{self, plot::Series};
 use crate::montecarlo::run_trials;
-use crate::scenario::six_targets::{HostFilter, SixTargets, Variant};
+use crate::scenario::phd::{HostFilter, SixTargets, Variant};
 use crate::stats::ospa::ospa;
 
 /// Command-line arguments.
@@ -32,7 +32,7 @@ pub struct Args {
     #[arg(long, default_value_t = 100)]
     pub runs: usize,
     /// Output directory.
-    #[arg(long, default_value = "out/psophd")]
+    #[arg(long, default_value = "out/phd")]
     pub out: PathBuf,
     /// Master seed.
     #[arg(long, default_value_t = 2019)]
@@ -166,7 +166,7 @@ pub fn run(args: &Args) -> Result<()> {
         if let Some(cap) = args.swarm_cap {
             sc.swarm_cap = cap;
         }
-        let label = format!("psophd {snr} dB");
+        let label = format!("phd {snr} dB");
         let seed = args.seed ^ (snr * 1000.0) as u64;
         let all: Vec<Result<Vec<RunResult>>> =
             pool.install(|| run_trials(seed, runs, &label, |_, rng| one_run(&sc, rng)));
