@@ -21,7 +21,7 @@ use faint_core::detect::Detector;
 use cortex_m_semihosting::hprintln;
 use faint_core::detect::phd::{PhdConfig, SmcPhdTbd};
 use faint_core::rng::Rng;
-use faint_golden::phd::{config, cube, Variant, FIRMWARE_WINDOW, FRAMES};
+use faint_golden::phd::{config, cube, ALGORITHMS, FIRMWARE_WINDOW, FRAMES};
 
 use crate::harness::{check, measure, row, Measurement, Static};
 
@@ -56,9 +56,9 @@ pub fn run() {
         RAM
     );
     coarse_start();
-    for v in Variant::ALL {
-        let cfg = config(FIRMWARE_WINDOW, v, PER_TARGET, BIRTHS, 8);
-        variant(det, buf, v.name(), cfg, FRAMES);
+    for alg in ALGORITHMS {
+        let cfg = config(FIRMWARE_WINDOW, alg, PER_TARGET, BIRTHS, 8);
+        variant(det, buf, alg.name, cfg, FRAMES);
     }
 }
 

@@ -135,14 +135,47 @@ pub fn cube(g: &CubeGeometry, k: usize, rng: &mut Rng, out: &mut [f32]) {
     faint_core::scene::cube_returns(out, &mut cells[..nc], &mut order, NOISE_VAR, rng);
 }
 
-pub use faint_core::detect::phd::Variant;
+/// One of Pei et al.'s three algorithms, as the golden cases and the firmware rows run it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Algorithm {
+    /// Display name (the firmware rows).
+    pub name: &'static str,
+    /// Golden case name.
+    pub case: &'static str,
+    /// With the PSO step.
+    pub pso: bool,
+    /// DBSCAN extraction (K-means otherwise).
+    pub dbscan: bool,
+}
+
+/// PHD-TBD, PSO-PHD-TBD with K-means, PSO-PHD-TBD with DBSCAN, in the paper's order.
+pub const ALGORITHMS: [Algorithm; 3] = [
+    Algorithm {
+        name: "PHD-TBD",
+        case: "phd.phd_tbd",
+        pso: false,
+        dbscan: false,
+    },
+    Algorithm {
+        name: "PSO-PHD-TBD (K-means)",
+        case: "phd.pso_kmeans",
+        pso: true,
+        dbscan: false,
+    },
+    Algorithm {
+        name: "PSO-PHD-TBD (DBSCAN)",
+        case: "phd.pso_dbscan",
+        pso: true,
+        dbscan: true,
+    },
+];
 
 /// The `six-targets` preset's filter settings in window `g`, with `particles_per_target`
 /// particles per estimated target, `births` birth particles per frame (also the minimum
 /// kept) and `points` swarm measurement points (at most the filter's `M`).
 pub fn config(
     g: CubeGeometry,
-    variant: Variant,
+    alg: Algorithm,
     particles_per_target: usize,
     births: usize,
     points: usize,
@@ -180,19 +213,17 @@ pub fn config(
         min_particles: births,
         clutter_lambda: 1.0,
         merge_adjacent_cells: true,
-        pso: match variant {
-            Variant::PhdTbd => None,
-            _ => Some(PsoConfig {
-                points,
-                ..PsoConfig::paper()
-            }),
-        },
-        extractor: match variant {
-            Variant::PsoDbscan => Extractor::Dbscan(DbscanParams {
+        pso: alg.pso.then(|| PsoConfig {
+            points,
+            ..PsoConfig::paper()
+        }),
+        extractor: if alg.dbscan {
+            Extractor::Dbscan(DbscanParams {
                 eps: 5.0,
                 min_pts: 10,
-            }),
-            _ => Extractor::KMeans { max_iter: 20 },
+            })
+        } else {
+            Extractor::KMeans { max_iter: 20 }
         },
     }
 }
@@ -236,14 +267,10 @@ pub type GoldenFilter = SmcPhdTbd<256, 256, 4, 4>;
 
 pub(crate) fn cases(emit: &mut dyn FnMut(&str, &[u32])) {
     let mut buf = [0.0f32; 4096];
-    for (v, name) in
-        Variant::ALL
-            .into_iter()
-            .zip(["phd.phd_tbd", "phd.pso_kmeans", "phd.pso_dbscan"])
-    {
-        match GoldenFilter::new(config(GOLDEN_WINDOW, v, 60, 64, 4), SEED) {
-            Ok(mut d) => emit(name, &run(&mut d, &GOLDEN_WINDOW, &mut buf)),
-            Err(_) => emit(name, &[ERR]),
+    for alg in ALGORITHMS {
+        match GoldenFilter::new(config(GOLDEN_WINDOW, alg, 60, 64, 4), SEED) {
+            Ok(mut d) => emit(alg.case, &run(&mut d, &GOLDEN_WINDOW, &mut buf)),
+            Err(_) => emit(alg.case, &[ERR]),
         }
     }
 }

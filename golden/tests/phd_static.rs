@@ -13,7 +13,9 @@ use faint_core::detect::Detector;
 use std::mem::MaybeUninit;
 
 use faint_core::detect::phd::{PhdConfig, PhdReport, SmcPhdTbd};
-use faint_golden::phd::{config, cube, truth, Variant, FIRMWARE_WINDOW, FRAMES, GOLDEN_WINDOW};
+use faint_golden::phd::{
+    config, cube, truth, Algorithm, ALGORITHMS, FIRMWARE_WINDOW, FRAMES, GOLDEN_WINDOW,
+};
 use faint_golden::SEED;
 
 use faint_core::model::power_cube::CubeGeometry;
@@ -67,31 +69,38 @@ fn run<const N: usize, const S: usize, const M: usize, const K: usize>(
         .collect()
 }
 
-fn cfg(v: Variant) -> PhdConfig {
+fn cfg(v: Algorithm) -> PhdConfig {
     config(GOLDEN_WINDOW, v, 60, 64, 4)
 }
 
 #[test]
 fn reconfigure_equals_new() {
     let cubes = frames(&GOLDEN_WINDOW);
-    for v in Variant::ALL {
+    for (i, v) in ALGORITHMS.into_iter().enumerate() {
         let want = run(&mut Small::new(cfg(v), 7).unwrap(), &cubes);
         assert!(
             want.iter().any(|f| f.0.n_hat > 0),
-            "{v:?}: scene never detected"
+            "{}: scene never detected",
+            v.name
         );
         // From zero.
         let mut z = Box::new(ZERO);
         z.configure(&cfg(v), 7).unwrap();
-        assert_eq!(run(&mut *z, &cubes), want, "{v:?} from zero");
+        assert_eq!(run(&mut *z, &cubes), want, "{} from zero", v.name);
         // From a filter of another variant (other extractor, with or without the swarm),
         // mid-run.
-        let other = Variant::ALL[(v as usize + 1) % 3];
+        let other = ALGORITHMS[(i + 1) % 3];
         let mut d = Box::new(Small::new(cfg(other), 3).unwrap());
         let _ = run(&mut *d, &cubes[..6]);
         d.configure(&cfg(v), 7).unwrap();
         assert_eq!(d.measurement_points(), &[] as &[[f32; 2]]);
-        assert_eq!(run(&mut *d, &cubes), want, "{v:?} after {other:?}");
+        assert_eq!(
+            run(&mut *d, &cubes),
+            want,
+            "{} after {}",
+            v.name,
+            other.name
+        );
         // A bad config is rejected and leaves the filter as it was.
         let before = d.clone();
         let bad = PhdConfig {
@@ -129,7 +138,7 @@ fn firmware_configuration_tracks_the_scene() {
 
 fn firmware_configuration_tracks_the_scene_body() {
     let mut states = [[0.0f32; 4]; 3];
-    for v in Variant::ALL {
+    for v in ALGORITHMS {
         let mut err = 0usize;
         for seed in 0..8u64 {
             let mut rng = Rng::from_stream(SEED, 600 + seed);

@@ -8,7 +8,6 @@ use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint::core::detect::mht::MhtConfig;
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint::core::detect::phd::Variant;
 use faint::core::detect::{run, Detector};
 use faint::core::model::doppler::{estimate_noise_variance, DopplerReport, ModelConfig};
 use faint::core::rng::Rng;
@@ -17,6 +16,7 @@ use faint::host::reproduce::crpf::run_detector;
 use faint::host::reproduce::mht::{Classic, Mht};
 use faint::host::scenario::crpf::{Noise, Othr};
 use faint::host::scenario::mht::SeaClutter;
+use faint::host::scenario::phd::Variant;
 use faint::host::scenario::phd::{HostFilter, SixTargets};
 
 use super::{faint, s, temp};

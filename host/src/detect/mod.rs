@@ -25,7 +25,7 @@ use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint_core::detect::mht::{ClassicHoughConfig, MhtConfig};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint_core::detect::phd::{PhdConfig, Variant};
+use faint_core::detect::phd::PhdConfig;
 use faint_core::detect::{run as run_frames, Detector, ScoreKind, Validate};
 use faint_core::model::doppler::estimate_noise_variance;
 use faint_core::model::plot::Plot;
@@ -37,7 +37,7 @@ use crate::io::input::{read_complex_frames, read_plots, read_real_frames, Frames
 use crate::montecarlo::progress_bar;
 use crate::reproduce::mht::{Classic, Mht};
 use crate::scenario::mht::SeaClutter;
-use crate::scenario::phd::{HostFilter, SixTargets};
+use crate::scenario::phd::{HostFilter, SixTargets, Variant};
 
 mod output;
 

@@ -106,8 +106,6 @@ pub const TABLE1: [TargetSpec; 6] = [
     },
 ];
 
-pub use faint_core::detect::phd::Variant;
-
 /// The preset.
 #[derive(Debug, Clone, Serialize)]
 pub struct SixTargets {
@@ -355,3 +353,28 @@ impl SixTargets {
 
 /// Capacities used on the host for this preset: particles, swarm entries, points, targets.
 pub type HostFilter = faint_core::detect::phd::SmcPhdTbd<8192, 16384, 10, 16>;
+
+/// Which of Pei et al.'s three algorithms a configuration of the preset runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Variant {
+    /// SMC-PHD TBD without PSO, K-means extraction.
+    PhdTbd,
+    /// PSO-PHD-TBD with K-means extraction.
+    PsoKMeans,
+    /// PSO-PHD-TBD with DBSCAN extraction (the paper's proposal).
+    PsoDbscan,
+}
+
+impl Variant {
+    /// All three, in the paper's order.
+    pub const ALL: [Variant; 3] = [Variant::PhdTbd, Variant::PsoKMeans, Variant::PsoDbscan];
+
+    /// Display name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::PhdTbd => "PHD-TBD",
+            Variant::PsoKMeans => "PSO-PHD-TBD (K-means)",
+            Variant::PsoDbscan => "PSO-PHD-TBD (DBSCAN)",
+        }
+    }
+}

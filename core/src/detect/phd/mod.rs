@@ -16,7 +16,6 @@ pub mod kmeans;
 pub mod ndsort;
 pub mod pso;
 pub mod smc_phd;
-mod variant;
 
 pub use dbscan::{Dbscan, DbscanParams};
 pub use kmeans::KMeans;
@@ -25,4 +24,3 @@ pub use smc_phd::{
     BirthComponent, BirthMode, BirthModel, Estimate, Extractor, PhdConfig, PhdReport, SmcPhdTbd,
     MAX_BIRTH_COMPONENTS,
 };
-pub use variant::Variant;

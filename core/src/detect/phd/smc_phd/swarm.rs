@@ -1,0 +1,212 @@
+//! The PSO step of PSO-PHD-TBD (Pei et al. 2019, §3): the measurement-derived points
+//! among the predicted survivors' cells, refined to the local log-LR maximum, and the
+//! swarm move of the gated particles.
+
+use super::*;
+
+impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N, S, M, K> {
+    pub(super) fn select_points(&mut self, cube: &PowerCube<'_>, n_surv: usize, want: usize) {
+        let g = *cube.geometry();
+        let data = cube.data();
+        let want = want.min(M);
+        let psf = self.cfg.psf;
+        // (z, ir, lb, jd) sorted descending by z.
+        let mut top = [(0.0f32, 0usize, 0usize, 0usize); M];
+        let mut amp = [0.0f32; M];
+        let mut nt = 0usize;
+        let mut last_cell = usize::MAX;
+        for i in 0..n_surv {
+            let s = self.x[i];
+            let c = RadarCoords::from_state(s[0], s[1], s[2], s[3]);
+            let Some((ir, jd, lb)) = g.cell_of(&c) else {
+                continue;
+            };
+            let cell = g.index(ir, jd, lb);
+            if cell == last_cell {
+                continue;
+            }
+            last_cell = cell;
+            // Point-spread-matched statistic `sum h^2 z` over the cells a target at the
+            // cell centre would cover (the small-signal form of the log likelihood
+            // ratio, `ln I0(x) ~ x^2 / 4`), not the single cell's power.
+            let centre = RadarCoords {
+                range: g.range_centre(ir),
+                doppler: g.doppler_centre(jd),
+                azimuth_deg: g.azimuth_centre(lb),
+            };
+            let mut z = 0.0f32;
+            psf.for_each_cell(&g, &centre, |idx, h| {
+                if let Some(&v) = data.get(idx) {
+                    z += h * h * v;
+                }
+            });
+            if nt == want && z <= top[nt - 1].0 {
+                continue;
+            }
+            // Thinning in range, azimuth *and* Doppler: targets born at the same place
+            // (Table 1: three at (250, 1500), three at (1750, 500)) share range/azimuth
+            // cells for several frames but not Doppler cells; thinning on position alone
+            // left one point for two targets and the swarm merged their clouds.
+            let near = |e: &(f32, usize, usize, usize)| {
+                e.1.abs_diff(ir) <= 1 && e.2.abs_diff(lb) <= 1 && e.3.abs_diff(jd) <= 1
+            };
+            if top[..nt].iter().any(|e| near(e) && e.0 >= z) {
+                continue;
+            }
+            // Drop weaker neighbours, then insert.
+            let mut k = 0;
+            for t in 0..nt {
+                if !near(&top[t]) {
+                    top[k] = top[t];
+                    amp[k] = amp[t];
+                    k += 1;
+                }
+            }
+            nt = k;
+            let mut p = nt.min(want - 1);
+            if nt < want {
+                nt += 1;
+            }
+            while p > 0 && top[p - 1].0 < z {
+                top[p] = top[p - 1];
+                amp[p] = amp[p - 1];
+                p -= 1;
+            }
+            top[p] = (z, ir, lb, jd);
+            amp[p] = math::sqrt(s[4].max(0.0));
+        }
+        let refine = self.cfg.pso.is_some_and(|p| p.refine_points);
+        for (k, e) in top[..nt].iter().enumerate() {
+            let (x, y) = if refine {
+                self.refine_point(cube, e.1, e.3, e.2, amp[k])
+            } else {
+                g.cell_position(e.1, e.2)
+            };
+            self.zpts[k] = [x, y];
+        }
+        self.n_z = nt;
+    }
+
+    /// Sub-cell `Z_m`: the (range, Doppler, azimuth) maximising the frame's log
+    /// likelihood ratio `sum ln L(z | x)` (eq. 20-23) of a target with amplitude `amp`
+    /// within cell `(ir, jd, lb)`: a 5 x 3 x 5 grid of quarter-cell steps, then a
+    /// 3 x 3 x 3 grid of eighth-cell steps around its best. Returns `(x, y)`.
+    fn refine_point(
+        &self,
+        cube: &PowerCube<'_>,
+        ir: usize,
+        jd: usize,
+        lb: usize,
+        amp: f32,
+    ) -> (f32, f32) {
+        let g = *cube.geometry();
+        let psf = self.cfg.psf;
+        let s2 = self.cfg.noise_var;
+        let mut best = (
+            f32::NEG_INFINITY,
+            g.range_centre(ir),
+            g.doppler_centre(jd),
+            g.azimuth_centre(lb),
+        );
+        for (half, step) in [(2i32, 0.25f32), (1, 0.125)] {
+            let (r0, d0, b0) = (best.1, best.2, best.3);
+            for a in -half..=half {
+                for c in -half..=half {
+                    for d in -1i32..=1 {
+                        let rc = RadarCoords {
+                            range: r0 + a as f32 * step * g.range_cell,
+                            doppler: d0 + d as f32 * step * g.doppler_cell,
+                            azimuth_deg: b0 + c as f32 * step * g.azimuth_cell_deg,
+                        };
+                        let l = cube.log_lr(&psf, &rc, amp, s2);
+                        if l > best.0 {
+                            best = (l, rc.range, rc.doppler, rc.azimuth_deg);
+                        }
+                    }
+                }
+            }
+        }
+        let b = best.3 / DEG_PER_RAD;
+        (best.1 * math::cos(b), best.1 * math::sin(b))
+    }
+
+    /// The swarm over at most `pso.max_members` of the gated particles.
+    pub(super) fn swarm_step(&mut self, pso: &PsoConfig) -> (usize, usize) {
+        let m = self.n_z;
+        if m == 0 {
+            return (0, 0);
+        }
+        let inv = 1.0 / (2.0 * pso.fitness_scale * pso.fitness_scale);
+        let nearest = |p: [f32; 2], z: &[[f32; 2]]| {
+            let mut best = (0usize, f32::INFINITY);
+            for (k, q) in z.iter().enumerate() {
+                let (dx, dy) = (p[0] - q[0], p[1] - q[1]);
+                let d = dx * dx + dy * dy;
+                if d < best.1 {
+                    best = (k, d);
+                }
+            }
+            best
+        };
+        self.swarm.clear();
+        // The gated particles (index in `order`, nearest point in `key`).
+        let mut gated = 0usize;
+        for i in 0..self.n {
+            let p = [self.x[i][0], self.x[i][2]];
+            let (k, d) = nearest(p, &self.zpts[..m]);
+            if math::exp(-d * inv) >= pso.gate {
+                self.order[gated] = i as u32;
+                self.key[gated] = k as u32;
+                gated += 1;
+            }
+        }
+        // At most `max_members` of them (and the swarm's capacity), evenly spaced:
+        // member `j` is gated particle `floor(j gated / take)`.
+        let take = gated.min(pso.max_members).min(Swarm::<S, M>::capacity());
+        let mut before = [0.0f32; M];
+        let mut n_s = 0usize;
+        for j in 0..take {
+            let g = (j as u64 * gated as u64 / take as u64) as usize;
+            let (i, k) = (self.order[g] as usize, self.key[g] as usize);
+            let p = [self.x[i][0], self.x[i][2]];
+            if !self.swarm.push(p, self.w[i], i as u32, k as u16) {
+                break;
+            }
+            // `g >= j`: slot `j` of `order` is free once read.
+            self.order[n_s] = i as u32;
+            before[k] += self.w[i];
+            n_s += 1;
+        }
+        if n_s == 0 {
+            return (0, 0);
+        }
+        let rep = self.swarm.run(pso, &self.zpts[..m], &mut self.rng);
+        let mut after = [0.0f32; M];
+        for k in 0..n_s {
+            let (g, _) = nearest(self.swarm.pos[k], &self.zpts[..m]);
+            after[g] += self.swarm.weight[k];
+        }
+
+        let mut scale = [1.0f32; M];
+        for g in 0..m {
+            if after[g] > 0.0 {
+                scale[g] = before[g] / after[g];
+            }
+        }
+        for k in 0..n_s {
+            let src = self.swarm.src[k] as usize;
+            let mut s = self.x[src];
+            s[0] = self.swarm.pos[k][0];
+            s[2] = self.swarm.pos[k][1];
+            self.scratch[k] = s;
+            let (g, _) = nearest(self.swarm.pos[k], &self.zpts[..m]);
+            self.lw[k] = self.swarm.weight[k] * scale[g];
+        }
+        for k in 0..n_s {
+            let slot = self.order[k] as usize;
+            self.x[slot] = self.scratch[k];
+            self.w[slot] = self.lw[k];
+        }
+        (n_s, rep.generations)
+    }
+}

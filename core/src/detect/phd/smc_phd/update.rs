@@ -1,0 +1,257 @@
+//! The update (eq. 20, 24-25) with the cell grouping by sort and union-find, the
+//! systematic resampling to `N_hat` targets' worth of particles (eq. 26), and the state
+//! extraction (DBSCAN or K-means).
+
+use super::*;
+
+/// The 13 "forward" neighbours of a cell (the other 13 are found from the other side).
+const NEIGHBOURS: [(i64, i64, i64); 13] = [
+    (0, 0, 1),
+    (0, 1, -1),
+    (0, 1, 0),
+    (0, 1, 1),
+    (1, -1, -1),
+    (1, -1, 0),
+    (1, -1, 1),
+    (1, 0, -1),
+    (1, 0, 0),
+    (1, 0, 1),
+    (1, 1, -1),
+    (1, 1, 0),
+    (1, 1, 1),
+];
+
+/// Union-find root with path halving.
+fn find(parent: &mut [u32], mut r: usize) -> usize {
+    while parent[r] as usize != r {
+        let gp = parent[parent[r] as usize];
+        parent[r] = gp;
+        r = gp as usize;
+    }
+    r
+}
+
+impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N, S, M, K> {
+    /// Weight update of eq. 20/24-25; returns `sum w`.
+    pub(super) fn update(&mut self, cube: &PowerCube<'_>) -> f32 {
+        let g = *cube.geometry();
+        let psf = self.cfg.psf;
+        let s2 = self.cfg.noise_var;
+        let n = self.n;
+        for i in 0..n {
+            let s = self.x[i];
+            let c = RadarCoords::from_state(s[0], s[1], s[2], s[3]);
+            let (ll, cell) = if self.w[i] > 0.0 && g.cell_of(&c).is_some() {
+                cube.log_lr_argmax(&psf, &c, math::sqrt(s[4].max(0.0)), s2)
+            } else {
+                (0.0, usize::MAX)
+            };
+            if cell == usize::MAX {
+                // Outside the surveillance cube (or zero weight): the particle dies.
+                self.key[i] = u32::MAX;
+                self.lw[i] = f32::NEG_INFINITY;
+            } else {
+                // Resolution cell of eq. 25: the covered cell with the largest factor.
+                self.key[i] = cell as u32;
+                let l = math::ln(self.w[i]) + ll;
+                self.lw[i] = if l.is_nan() || l == f32::INFINITY {
+                    f32::NEG_INFINITY
+                } else {
+                    l
+                };
+            }
+            self.order[i] = i as u32;
+        }
+        {
+            let key = &self.key;
+            self.order[..n].sort_unstable_by_key(|&i| (key[i as usize], i));
+        }
+        let ln_lambda = math::ln(self.cfg.clutter_lambda);
+        // Runs of equal cell; `run_of[i]` for every particle (u32::MAX outside).
+        let mut nr = 0usize;
+        let mut s = 0usize;
+        while s < n {
+            let k = self.key[self.order[s] as usize];
+            let mut e = s;
+            while e < n && self.key[self.order[e] as usize] == k {
+                self.anc[self.order[e] as usize] = if k == u32::MAX { u32::MAX } else { nr as u32 };
+                e += 1;
+            }
+            if k != u32::MAX {
+                self.run_key[nr] = k;
+                self.parent[nr] = nr as u32;
+                nr += 1;
+            }
+            s = e;
+        }
+        // Merge runs whose cells touch (|d| <= 1 on every axis): one target's energy
+        // spreads over neighbouring cells, and particles attributed to either are one
+        // "resolution cell" for the normalisation of eq. 20 (else every neighbour cell
+        // claims up to one target).
+        if self.cfg.merge_adjacent_cells {
+            for r in 0..nr {
+                let (ir, jd, lb) = g.unindex(self.run_key[r] as usize);
+                for (a, b, c) in NEIGHBOURS {
+                    let (x, y, z) = (ir as i64 + a, jd as i64 + b, lb as i64 + c);
+                    if x < 0
+                        || y < 0
+                        || z < 0
+                        || x >= g.n_range as i64
+                        || y >= g.n_doppler as i64
+                        || z >= g.n_azimuth as i64
+                    {
+                        continue;
+                    }
+                    let idx = g.index(x as usize, y as usize, z as usize) as u32;
+                    if let Ok(q) = self.run_key[..nr].binary_search(&idx) {
+                        let (ra, rb) = (find(&mut self.parent, r), find(&mut self.parent, q));
+                        if ra != rb {
+                            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+                            self.parent[hi] = lo as u32;
+                        }
+                    }
+                }
+            }
+        }
+        // Per group: max log weight, then sum, then denominator (in `pts[root]`).
+        for r in 0..nr {
+            self.pts[r] = [f32::NEG_INFINITY, 0.0];
+        }
+        for i in 0..n {
+            let r = self.anc[i];
+            if r != u32::MAX {
+                let root = find(&mut self.parent, r as usize);
+                self.anc[i] = root as u32;
+                self.pts[root][0] = self.pts[root][0].max(self.lw[i]);
+            }
+        }
+        for i in 0..n {
+            let r = self.anc[i];
+            if r != u32::MAX && self.pts[r as usize][0] > f32::NEG_INFINITY {
+                self.pts[r as usize][1] += math::exp(self.lw[i] - self.pts[r as usize][0]);
+            }
+        }
+        for r in 0..nr {
+            if self.parent[r] as usize == r && self.pts[r][0] > f32::NEG_INFINITY {
+                let log_rho = self.pts[r][0] + math::ln(self.pts[r][1]);
+                self.pts[r][1] = math::log_add_exp(ln_lambda, log_rho);
+            }
+        }
+        let mut total = KahanSum::new();
+        for i in 0..n {
+            let r = self.anc[i];
+            let wi = if r == u32::MAX || self.lw[i] == f32::NEG_INFINITY {
+                0.0
+            } else {
+                math::exp(self.lw[i] - self.pts[r as usize][1])
+            };
+            self.w[i] = wi;
+            total.add(wi);
+        }
+        total.value()
+    }
+
+    pub(super) fn resample(&mut self, n_hat: usize, mass: f32) -> bool {
+        let cap = N - self.cfg.birth.particles;
+        let l = self
+            .cfg
+            .particles_per_target
+            .saturating_mul(n_hat)
+            .max(self.cfg.min_particles)
+            .min(cap);
+        if l == 0 || self.n == 0 {
+            return false;
+        }
+        if resample(
+            Scheme::Systematic,
+            &self.w[..self.n],
+            &mut self.anc[..l],
+            &mut self.rng,
+        )
+        .is_err()
+        {
+            return false;
+        }
+        for j in 0..l {
+            self.scratch[j] = self.x[self.anc[j] as usize];
+        }
+        self.x[..l].copy_from_slice(&self.scratch[..l]);
+        let wl = mass / l as f32;
+        for w in self.w[..l].iter_mut() {
+            *w = wl;
+        }
+        self.n = l;
+        true
+    }
+
+    pub(super) fn extract(&mut self, n_hat: usize) -> Result<()> {
+        self.n_est = 0;
+        let n = self.n;
+        if n_hat == 0 || n == 0 {
+            return Ok(());
+        }
+        for i in 0..n {
+            self.pts[i] = [self.x[i][0], self.x[i][2]];
+        }
+        match self.cfg.extractor {
+            Extractor::Dbscan(p) => {
+                let x = &self.x;
+                let est = &mut self.est;
+                let n_est = &mut self.n_est;
+                let want = n_hat.min(K);
+                self.dbscan.run(&self.pts[..n], &p, |members| {
+                    let size = members.len() as u32;
+                    if *n_est == want && est[want - 1].support >= size {
+                        return;
+                    }
+                    let mut acc = [0.0f32; 5];
+                    for &m in members {
+                        for (a, v) in acc.iter_mut().zip(&x[m as usize]) {
+                            *a += v;
+                        }
+                    }
+                    let inv = 1.0 / size as f32;
+                    let e = Estimate {
+                        state: acc.map(|a| a * inv),
+                        support: size,
+                    };
+                    let mut pos = (*n_est).min(want - 1);
+                    if *n_est < want {
+                        *n_est += 1;
+                    }
+                    while pos > 0 && est[pos - 1].support < size {
+                        est[pos] = est[pos - 1];
+                        pos -= 1;
+                    }
+                    est[pos] = e;
+                })?;
+            }
+            Extractor::KMeans { max_iter } => {
+                let k = self
+                    .kmeans
+                    .run(&self.pts[..n], n_hat, max_iter, &mut self.rng)?;
+                let mut acc = [[0.0f32; 5]; K];
+                for i in 0..n {
+                    let c = self.kmeans.assign[i] as usize;
+                    if c < k {
+                        for (a, v) in acc[c].iter_mut().zip(&self.x[i]) {
+                            *a += v;
+                        }
+                    }
+                }
+                for c in 0..k {
+                    let cnt = self.kmeans.counts[c];
+                    if cnt > 0 {
+                        let inv = 1.0 / cnt as f32;
+                        self.est[self.n_est] = Estimate {
+                            state: acc[c].map(|a| a * inv),
+                            support: cnt,
+                        };
+                        self.n_est += 1;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}

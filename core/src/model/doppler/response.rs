@@ -1,0 +1,373 @@
+//! The windowed-DFT response `h_k(x)` of a target: the analysis [`Window`], the table of
+//! its DTFT and the direct five-bin [`Projection`] of a frame (see the parent module for
+//! the method and its error bound).
+
+use crate::math;
+use crate::{Complex32, Error, Result};
+
+/// Largest frame length (bins) the fixed-size buffers hold.
+pub const MAX_BINS: usize = 64;
+/// Half-width `J` of the evaluated bin span.
+pub const HALF_SPAN: usize = 2;
+/// Bins evaluated per particle: `2J + 1`.
+pub const SPAN: usize = 2 * HALF_SPAN + 1;
+/// Table points per bin of the window's DTFT.
+pub const TABLE_STEPS: usize = 128;
+pub(super) const TABLE_LEN: usize = SPAN * TABLE_STEPS + 1;
+/// One interpolation row: for each of the [`SPAN`] bins, `[a.re, a.im, (b - a).re,
+/// (b - a).im]` with `a`, `b` the two table points around the bin's position.
+pub(super) type Row = [[f32; 4]; SPAN];
+/// `0.5 - f32::EPSILON / 4`: `trunc(x + copysign(HALF_DOWN, x))` is `roundf(x)`.
+const HALF_DOWN: f32 = 0.5 - 0.25 * f32::EPSILON;
+/// Below this magnitude (2^22) a table position is rounded inline.
+const LARGE: f32 = 4_194_304.0;
+/// Stated bound on `||h_approx - h_exact|| / ||h_exact||` for the Hamming window, `m = 32`
+/// (measured maximum 2.65e-2, dominated by the side-lobe energy left out).
+pub const RESPONSE_ERROR_BOUND: f64 = 3e-2;
+
+/// Analysis window of the windowed DFT.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
+pub enum Window {
+    /// `w_n = 1`.
+    Rectangular,
+    /// Symmetric Hamming, `w_n = 0.54 - 0.46 cos(2 pi n / (m - 1))` (the preset).
+    #[default]
+    Hamming,
+    /// Symmetric Hann, `w_n = 0.5 - 0.5 cos(2 pi n / (m - 1))`.
+    Hann,
+}
+
+impl Window {
+    /// Coefficient `w_n` of an `m`-point window, in `f64`.
+    pub fn coefficient(self, n: usize, m: usize) -> f64 {
+        let c = if m > 1 {
+            libm::cos(2.0 * core::f64::consts::PI * n as f64 / (m - 1) as f64)
+        } else {
+            1.0
+        };
+        match self {
+            Window::Rectangular => 1.0,
+            Window::Hamming => 0.54 - 0.46 * c,
+            Window::Hann => 0.5 - 0.5 * c,
+        }
+    }
+}
+
+/// `<z, h>` and `||h||^2` of one hypothesised target against one frame.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Projection {
+    /// `sum_b conj(z_b) h_b` over the evaluated bins.
+    pub zh: Complex32,
+    /// `sum_b |h_b|^2` over the evaluated bins.
+    pub hh: f32,
+}
+
+impl Projection {
+    /// `||z - h||^2 = zz - 2 Re<z,h> + ||h||^2`, floored at `f32::MIN_POSITIVE` so its
+    /// logarithm is finite (an exact fit or an all-zero frame).
+    #[inline]
+    pub fn residual_norm2(&self, zz: f32) -> f32 {
+        let d = zz - 2.0 * self.zh.re + self.hh;
+        if d > f32::MIN_POSITIVE {
+            d
+        } else {
+            f32::MIN_POSITIVE
+        }
+    }
+
+    /// Gaussian log likelihood ratio `ln p(z|x)/p(z|0) = (2 Re<z,h> - ||h||^2) / s2` for
+    /// independent complex Gaussian bins of variance `s2`.
+    #[inline]
+    pub fn log_lr(&self, inv_var: f32) -> f32 {
+        (2.0 * self.zh.re - self.hh) * inv_var
+    }
+}
+
+/// The windowed-DFT response of a complex exponential, tabulated (see the module docs).
+#[derive(Debug, Clone)]
+pub struct DopplerModel {
+    pub(super) m: usize,
+    /// `m as f32` (converted once, not per particle).
+    pub(super) m_f32: f32,
+    pub(super) ts: f32,
+    pub(super) window: Window,
+    /// `rows[i0][j]`: the table points `t = i0 + (SPAN - 1 - j) S` and `t + 1` of bin `j`
+    /// (`S` = [`TABLE_STEPS`]), so one fractional table position serves all five bins
+    /// with one bounds check and no index arithmetic in the hot loop.
+    pub(super) rows: [Row; TABLE_STEPS],
+    /// `U = fd u_scale + u_off` is `128 (pos + 1/2 + m)` (`pos = fd ts m`): `U >> 7` is the
+    /// nearest bin plus `m`, `U & 127` the row, the rest the fraction.
+    pub(super) u_scale: f32,
+    pub(super) u_off: f32,
+    /// `first_of[q] = (q - m - J) mod m` for `q = U >> 7 < 2m`.
+    pub(super) first_of: [u8; 2 * MAX_BINS],
+    /// `[H0, H1, H2]` of each row: `sum_j |a_j + f d_j|^2 = H0 + f (H1 + f H2)`.
+    pub(super) hq: [[f32; 3]; TABLE_STEPS],
+    pub(super) window_sum: f32,
+    pub(super) window_energy: f32,
+}
+
+impl DopplerModel {
+    /// Builds the table for `m` bins (`SPAN <= m <= MAX_BINS`) and sample interval `ts`.
+    pub fn new(m: usize, ts: f32, window: Window) -> Result<Self> {
+        if !(SPAN..=MAX_BINS).contains(&m) {
+            return Err(Error::InvalidConfig("bins per frame (5..=64)"));
+        }
+        if !(ts.is_finite() && ts > 0.0) {
+            return Err(Error::InvalidConfig("sample interval ts"));
+        }
+        let mut table = [Complex32::new(0.0, 0.0); TABLE_LEN];
+        for (t, slot) in table.iter_mut().enumerate() {
+            let u = -(HALF_SPAN as f64 + 0.5) + t as f64 / TABLE_STEPS as f64;
+            let (re, im) = dtft(window, m, u / m as f64);
+            *slot = Complex32::new(re as f32, im as f32);
+        }
+        let mut rows = [[[0.0f32; 4]; SPAN]; TABLE_STEPS];
+        for (i0, row) in rows.iter_mut().enumerate() {
+            for (j, cell) in row.iter_mut().enumerate() {
+                let t = i0 + (SPAN - 1 - j) * TABLE_STEPS;
+                let (a, b) = match (table.get(t), table.get(t + 1)) {
+                    (Some(&a), Some(&b)) => (a, b),
+                    _ => (Complex32::new(0.0, 0.0), Complex32::new(0.0, 0.0)),
+                };
+                *cell = [a.re, a.im, b.re - a.re, b.im - a.im];
+            }
+        }
+        let mut first_of = [0u8; 2 * MAX_BINS];
+        for (q, f) in first_of.iter_mut().enumerate() {
+            *f = (q as i64 - m as i64 - HALF_SPAN as i64).rem_euclid(m as i64) as u8;
+        }
+        let mut hq = [[0.0f32; 3]; TABLE_STEPS];
+        for (h, row) in hq.iter_mut().zip(rows.iter()) {
+            let (mut h0, mut h1, mut h2) = (0.0f64, 0.0f64, 0.0f64);
+            for c in row.iter() {
+                let (ar, ai, dr, di) = (c[0] as f64, c[1] as f64, c[2] as f64, c[3] as f64);
+                h0 += ar * ar + ai * ai;
+                h1 += 2.0 * (ar * dr + ai * di);
+                h2 += dr * dr + di * di;
+            }
+            *h = [h0 as f32, h1 as f32, h2 as f32];
+        }
+        let mut s = 0.0f64;
+        let mut s2 = 0.0f64;
+        for n in 0..m {
+            let w = window.coefficient(n, m);
+            s += w;
+            s2 += w * w;
+        }
+        Ok(Self {
+            m,
+            m_f32: m as f32,
+            ts,
+            window,
+            rows,
+            u_scale: (ts as f64 * m as f64 * TABLE_STEPS as f64) as f32,
+            u_off: (TABLE_STEPS / 2 + TABLE_STEPS * m) as f32,
+            first_of,
+            hq,
+            window_sum: s as f32,
+            window_energy: s2 as f32,
+        })
+    }
+
+    /// Bins per frame `m`.
+    pub fn bins(&self) -> usize {
+        self.m
+    }
+
+    /// Sample interval `ts` (s).
+    pub fn ts(&self) -> f32 {
+        self.ts
+    }
+
+    /// Frame time `dT = m ts` (s).
+    pub fn frame_time(&self) -> f32 {
+        self.m as f32 * self.ts
+    }
+
+    /// The window.
+    pub fn window(&self) -> Window {
+        self.window
+    }
+
+    /// `sum_n w_n = |W(0)|`, the peak gain of a bin-centred target.
+    pub fn window_sum(&self) -> f32 {
+        self.window_sum
+    }
+
+    /// `sum_n w_n^2`: a white time-domain noise of variance `s2` has per-bin variance
+    /// `s2 * window_energy` after the windowed DFT.
+    pub fn window_energy(&self) -> f32 {
+        self.window_energy
+    }
+
+    /// Unambiguous Doppler band `[-1/(2 ts), 1/(2 ts))` (Hz).
+    pub fn band(&self) -> (f32, f32) {
+        let h = 0.5 / self.ts;
+        (-h, h)
+    }
+
+    /// Nearest bin `b0` and interpolation position: the first of the [`SPAN`] bins is
+    /// `b0 - J (mod m)`; returns `(first_bin, interpolation row, fraction)`.
+    #[inline]
+    pub(super) fn locate(&self, fd: f32) -> (usize, &Row, f32) {
+        let (first, i0, frac) = self.locate_i(fd);
+        (first, self.row(i0), frac)
+    }
+
+    /// Interpolation row `i0` (`i0 < TABLE_STEPS` by construction; row 0 otherwise).
+    #[inline(always)]
+    pub(super) fn row(&self, i0: usize) -> &Row {
+        match self.rows.get(i0) {
+            Some(r) => r,
+            None => &self.rows[0],
+        }
+    }
+
+    /// [`locate`](Self::locate) with the row index.
+    #[inline(always)]
+    pub(super) fn locate_i(&self, fd: f32) -> (usize, usize, f32) {
+        let pos = fd * self.ts * self.m_f32;
+        let pos = if pos.is_finite() { pos } else { 0.0 };
+        let (b, bi) = if pos > -LARGE && pos < LARGE {
+            // libm's roundf, trunc(x + copysign(0.5 - eps/4, x)), inlined.
+            let h = if pos < 0.0 { -HALF_DOWN } else { HALF_DOWN };
+            let bi = (pos + h) as i32;
+            (bi as f32, bi)
+        } else {
+            // Out of any band; `i32::MAX` sends `first` to the exact path below.
+            let b = math::round(pos);
+            (b, i32::MAX)
+        };
+        let delta = pos - b; // in [-0.5, 0.5]
+        let p0 = (delta + 0.5) * TABLE_STEPS as f32;
+        let mut i0 = p0 as usize; // p0 >= 0
+        if i0 >= TABLE_STEPS {
+            i0 = TABLE_STEPS - 1;
+        }
+        let frac = p0 - i0 as f32;
+        // b - J (mod m) without a 64-bit division in the usual case |b| < m.
+        let m = self.m as i32;
+        let mut first = bi - HALF_SPAN as i32;
+        if first < 0 {
+            first += m;
+        }
+        if !(0..m).contains(&first) {
+            first = (b as i64 - HALF_SPAN as i64).rem_euclid(m as i64) as i32;
+        }
+        (first as usize, i0, frac)
+    }
+
+    /// The evaluated response: `out[j] = h_{first + j (mod m)}` for `j = 0..SPAN`;
+    /// returns `first`. Bins outside the span are taken as zero.
+    pub fn response(&self, fd: f32, amp: f32, out: &mut [Complex32; SPAN]) -> usize {
+        let (first, row, frac) = self.locate(fd);
+        for (o, c) in out.iter_mut().zip(row.iter()) {
+            let a = Complex32::new(c[0], c[1]);
+            let d = Complex32::new(c[2], c[3]);
+            *o = (a + d * frac) * amp;
+        }
+        first
+    }
+
+    /// `<z, h(fd, amp)>` and `||h||^2` over the evaluated bins. `z` must hold `m` bins
+    /// (not checked here: the detectors check each frame once; a shorter `z` reads its
+    /// missing bins as zero).
+    #[inline]
+    pub fn project(&self, z: &[Complex32], fd: f32, amp: f32) -> Projection {
+        self.project_impl::<true>(z, fd, amp)
+    }
+
+    /// [`project`](Self::project) without `Im <z, h>` (returned as 0): all a cost
+    /// `||z - h||^2` or a Gaussian likelihood ratio needs; bit-identical otherwise.
+    #[inline]
+    pub fn project_re(&self, z: &[Complex32], fd: f32, amp: f32) -> Projection {
+        self.project_impl::<false>(z, fd, amp)
+    }
+
+    #[cold]
+    #[inline(never)]
+    pub(super) fn project_direct<const IM: bool>(
+        &self,
+        z: &[Complex32],
+        fd: f32,
+        amp: f32,
+    ) -> Projection {
+        self.project_impl::<IM>(z, fd, amp)
+    }
+
+    #[inline(always)]
+    fn project_impl<const IM: bool>(&self, z: &[Complex32], fd: f32, amp: f32) -> Projection {
+        let (first, row, frac) = self.locate(fd);
+        let (zr, zi, hh) = match z
+            .get(first..first + SPAN)
+            .and_then(|s| <&[Complex32; SPAN]>::try_from(s).ok())
+        {
+            // The five bins do not wrap (27 of 32 positions for m = 32).
+            Some(zs) => kernel::<IM>(row, zs, frac),
+            None => {
+                let mut zs = [Complex32::new(0.0, 0.0); SPAN];
+                let mut b = first;
+                for o in zs.iter_mut() {
+                    if let Some(&v) = z.get(b) {
+                        *o = v;
+                    }
+                    b += 1;
+                    if b == self.m {
+                        b = 0;
+                    }
+                }
+                kernel::<IM>(row, &zs, frac)
+            }
+        };
+        Projection {
+            zh: Complex32::new(zr * amp, zi * amp),
+            hh: hh * amp * amp,
+        }
+    }
+}
+
+/// `sum_b conj(z_b) h_b / A` and `sum_b |h_b|^2 / A^2` over one interpolation row:
+/// fixed-size arrays, fully unrolled, no bounds checks.
+#[inline(always)]
+fn kernel<const IM: bool>(row: &Row, zs: &[Complex32; SPAN], frac: f32) -> (f32, f32, f32) {
+    // The sums start from the first bin's terms instead of 0.0 + them: the same values,
+    // except that a sum of signed zeros may keep its sign (-0.0 instead of +0.0), which
+    // no cost, gate or weight can tell apart (each is squared or added first).
+    let (c, zb) = (&row[0], &zs[0]);
+    let hr = c[0] + c[2] * frac;
+    let hi = c[1] + c[3] * frac;
+    let mut zr = zb.re * hr + zb.im * hi;
+    let mut zi = if IM { zb.re * hi - zb.im * hr } else { 0.0 };
+    let mut hh = hr * hr + hi * hi;
+    for j in 1..SPAN {
+        let (c, zb) = (&row[j], &zs[j]);
+        let hr = c[0] + c[2] * frac;
+        let hi = c[1] + c[3] * frac;
+        // conj(z) h
+        zr += zb.re * hr + zb.im * hi;
+        if IM {
+            zi += zb.re * hi - zb.im * hr;
+        }
+        hh += hr * hr + hi * hi;
+    }
+    (zr, zi, hh)
+}
+
+/// `W(theta) = sum_n w_n exp(j 2 pi theta n)` in `f64`.
+pub fn dtft(window: Window, m: usize, theta: f64) -> (f64, f64) {
+    let mut re = 0.0;
+    let mut im = 0.0;
+    for n in 0..m {
+        let w = window.coefficient(n, m);
+        let ph = 2.0 * core::f64::consts::PI * theta * n as f64;
+        re += w * libm::cos(ph);
+        im += w * libm::sin(ph);
+    }
+    (re, im)
+}
