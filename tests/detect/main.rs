@@ -4,6 +4,7 @@
 //! with the reports.
 
 mod bad_input;
+mod commands;
 mod interface;
 mod round_trip;
 

@@ -1,18 +1,6 @@
 //! Bad input at the host boundary: clear message, non-zero exit, no panic trace.
 
-use std::process::Command;
-
-fn faint(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_faint"))
-        .args(args)
-        .output()
-        .expect("run faint");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use super::faint;
 
 #[test]
 fn unknown_scenario_is_a_clear_error() {

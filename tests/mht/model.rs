@@ -1,6 +1,5 @@
 //! MHT-TBD analytic model: exact run-value law vs brute force and simulation, hit
 //! probabilities, and the model threshold applied in simulation.
-#![allow(clippy::needless_range_loop)]
 
 use faint::core::detect::Detector;
 use faint::core::rng::Rng;

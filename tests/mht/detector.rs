@@ -1,6 +1,5 @@
 //! MHT-TBD core: censoring against a brute-force MSHT reference, detection of a clean
 //! target, the classic baseline, quantisers, and bad input.
-#![allow(clippy::needless_range_loop)]
 
 use faint::core::detect::mht::{
     ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, NO_PLOT,

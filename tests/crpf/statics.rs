@@ -1,4 +1,4 @@
-//! `reconfigure` restarts a detector in place exactly as `new` builds one, including
+//! `configure` restarts a detector in place exactly as `new` builds one, including
 //! from an all-zero value (how the firmware keeps the detectors in `static` memory).
 //!
 //! The all-zero values are `const` items: the compiler's const evaluator checks that

@@ -1,0 +1,12 @@
+//! CRPF-TBD (Lu, Wang, Zhang 2017) and its comparators PF-TBD, JOTT and PF-LRT: the
+//! observation model, the noise generators, the detectors, their static configuration,
+//! the threshold calibration and the reproduction. One test binary for the family.
+
+mod calibration;
+mod cli;
+mod detectors;
+mod model;
+mod noise;
+mod reproduce;
+mod sizes;
+mod statics;

@@ -1,0 +1,8 @@
+//! MHT-TBD (Bao et al. 2022) and the classic Hough TBD: the detector against brute-force
+//! references, the analytic detection model, and the simulation-calibrated threshold. One
+//! test binary for the family.
+#![allow(clippy::needless_range_loop)]
+
+mod calibration;
+mod detector;
+mod model;

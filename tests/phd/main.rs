@@ -1,0 +1,7 @@
+//! PSO-PHD-TBD (Pei et al. 2019) and PHD-TBD: the swarm, sort and clustering building
+//! blocks against brute force, the filter on the `six-targets` preset, and the
+//! reproduction's command line. One test binary for the family.
+
+mod algorithms;
+mod cli;
+mod filter;
