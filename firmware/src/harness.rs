@@ -259,7 +259,7 @@ pub fn check<T, E: core::fmt::Debug>(r: Result<T, E>) -> T {
     }
 }
 
-/// Ends the QEMU session with exit status 0.
+/// Ends the QEMU run with exit status 0.
 pub fn exit_success() -> ! {
     debug::exit(debug::EXIT_SUCCESS);
     #[allow(clippy::empty_loop)]

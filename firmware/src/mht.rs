@@ -1,4 +1,4 @@
-//! Cost of MHT-TBD (paper 003) on the Cortex-M4F at the sea-clutter preset's densest
+//! Cost of MHT-TBD (Bao et al. 2022) on the Cortex-M4F at the sea-clutter preset's densest
 //! clutter: 398 clutter plots per scan (a fixed count, the Poisson mean), uniform over the
 //! 6 km x 6 km area, plus 5 constant-velocity targets detected with Pd0 = 0.85 and 5 m
 //! noise, 30 scans, `M = 3`, `256 x 180` grid, `gamma_1 = 22`. Scenes are generated from a

@@ -1,4 +1,4 @@
-//! Cost of PHD-TBD, PSO-PHD-TBD (K-means) and PSO-PHD-TBD (DBSCAN) (paper 002) on the
+//! Cost of PHD-TBD, PSO-PHD-TBD (K-means) and PSO-PHD-TBD (DBSCAN) (Pei et al. 2019) on the
 //! Cortex-M4F, in a configuration that fits 1 MiB of RAM: `SmcPhdTbd<6144, 1024, 8, 8>`
 //! (6144 particles, e.g. five targets at the preset's 1000 plus 500 births; a 1024-entry
 //! swarm, so the preset's 512 particles move; 8 measurement points, 8 targets) with the

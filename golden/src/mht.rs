@@ -1,4 +1,4 @@
-//! MHT-TBD (paper 003): censoring flags, DMHT geometry and recovered tracks of a small
+//! MHT-TBD (Bao et al. 2022): censoring flags, DMHT geometry and recovered tracks of a small
 //! scene (1.5 km square, 10 scans, 40 clutter plots per scan, 2 targets), and the classic
 //! detector's peaks on the same scans. Stack use ~14 KiB (the detector lives on the stack).
 

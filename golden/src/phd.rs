@@ -1,4 +1,4 @@
-//! PSO-PHD-TBD (paper 002): a deterministic three-target scene at 9 dB, generated in
+//! PSO-PHD-TBD (Pei et al. 2019): a deterministic three-target scene at 9 dB, generated in
 //! `no_std` code so that the golden case, the firmware's instruction counts and the host
 //! tests run on the same cubes, and the golden case itself (the estimated count, the
 //! PHD mass and the estimates' bits per frame of PHD-TBD, PSO-PHD-TBD with K-means and

@@ -213,7 +213,7 @@ fn same_seed_same_output() {
 }
 
 /// Count error and OSPA of `variants` at 9 dB, frames 20-28 (all six targets alive since
-/// frame 17), 4 seeds; asserts the issue-5 bounds.
+/// frame 17), 4 seeds; asserts the count and OSPA bounds of the filter's goal.
 fn count_follows_truth_at_9_db(variants: &[Variant]) {
     let variants = variants.to_vec();
     big_stack(|| {
@@ -261,8 +261,8 @@ fn count_follows_truth_at_9_db(variants: &[Variant]) {
     });
 }
 
-/// The issue-5 goal for PHD-TBD (measured on these seeds: mean |N_hat - N| 0.639, mean
-/// OSPA 16.89 m; before this session's fixes 2.25 / 34.1 m).
+/// PHD-TBD's count and OSPA goal at 9 dB (measured on these seeds: mean |N_hat - N|
+/// 0.639, mean OSPA 16.89 m; 2.25 / 34.1 m before the birth and cell-grouping fixes).
 #[test]
 fn at_9_db_the_phd_tbd_count_follows_the_truth_after_settling() {
     count_follows_truth_at_9_db(&[Variant::PhdTbd]);

@@ -59,7 +59,7 @@
 //! bytes of weights and ancestors and a 33 KB fixed part, the response table (11.7 KB)
 //! and the projection cache (20 KB) (about 279 KB at `N = 6000`): build
 //! large instances in a `Box`, or zeroed in a `static` and set up by
-//! [`Detector::configure`](crate::detect::Detector::configure).
+//! [`Detector::configure`].
 
 use crate::detect::{Detection, Detector, ScoreKind, Validate};
 use crate::existence::{BirthGaps, ExistenceDraw};

@@ -48,7 +48,7 @@ impl GaussConfig {
         self.model.build()
     }
 
-    /// What every Gaussian comparator's `new` / `reconfigure` needs: `N > 0`, the built
+    /// What every Gaussian comparator's `new` / `configure` needs: `N > 0`, the built
     /// model and `1 / s2`.
     pub(crate) fn prepare<const N: usize>(&self) -> Result<(Model, f32)> {
         if N == 0 {

@@ -1,6 +1,6 @@
 //! Plots: the output of a pre-detector (CFAR + plot extractor), one list per scan.
 
-/// One pre-detected plot `s = [a, x, y]` (paper 003, eq. 3): amplitude and two Cartesian
+/// One pre-detected plot `s = [a, x, y]` (Bao et al. 2022, eq. 3): amplitude and two Cartesian
 /// coordinates in metres. A scan is a borrowed slice `&[Plot]`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Plot {

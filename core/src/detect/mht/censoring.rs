@@ -1,4 +1,4 @@
-//! Stage 2, plot censoring (paper 003, §3.1): modified single-frame Hough transform
+//! Stage 2, plot censoring (Bao et al. 2022, §3.1): modified single-frame Hough transform
 //! (MSHT, eq. 4), M-scan sliding-window collinearity (eq. 5) and velocity gate (eq. 6).
 //!
 //! The rule implemented: a plot `s_{k,m}` joins the effective set `S_ep` when, for some

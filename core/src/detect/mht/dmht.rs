@@ -1,4 +1,4 @@
-//! Stage 3, detection and track recovery (paper 003, §3.2): binary-integration Hough
+//! Stage 3, detection and track recovery (Bao et al. 2022, §3.2): binary-integration Hough
 //! accumulator, 3x3 Gaussian smoothing, threshold, condensing, line-to-plot association.
 //!
 //! The accumulator is shared with the classic detector (`classic.rs`); the data-matched

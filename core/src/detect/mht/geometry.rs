@@ -1,5 +1,5 @@
 //! Hough geometry: an `R x A` (`N_rho x N_theta`) grid, `theta_a = a pi / A`,
-//! `rho = (x - x0) cos(theta) + (y - y0) sin(theta)` (paper 003, eq. 1 and eq. 7), and the
+//! `rho = (x - x0) cos(theta) + (y - y0) sin(theta)` (Bao et al. 2022, eq. 1 and eq. 7), and the
 //! rho quantisation.
 //!
 //! Two equivalent quantisers are provided:

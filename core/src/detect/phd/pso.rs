@@ -61,7 +61,7 @@ fn lex_desc(a: &[f32], b: &[f32]) -> core::cmp::Ordering {
 /// Writes the front index (0 = non-dominated) of each solution into `rank[..n]` and
 /// returns the number of fronts. Workspace: `order`, `next`, `head` of length `>= n`.
 /// Objective values must be finite (NaN compares as "equal" and does not panic).
-/// With `m <= 2` only each front's newest member is checked (see [`ens_bs`]), so the
+/// With `m <= 2` only each front's newest member is checked (see `ens_bs`), so the
 /// sort is O(N log N) whatever the front sizes.
 pub fn non_dominated_sort<const M: usize>(
     f: &[[f32; M]],
@@ -416,7 +416,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     /// Runs the multi-objective PSO on the parents `0..len` towards `points`:
     /// per generation, children by eq. 8-9 plus mutation (entry `i % 3`: 0 unchanged,
     /// 1 one common uniform increment, 2 an own uniform increment), fitness eq. 18-19,
-    /// merge, and the elitist selection of [`Swarm::select`]. Runs `generations`, then
+    /// merge, and the elitist selection of `Swarm::select`. Runs `generations`, then
     /// continues while the mean best-objective fitness is below `threshold`, at most
     /// `max_generations` in all. Weights ride along; the caller renormalises.
     ///

@@ -217,7 +217,7 @@ pub struct PhdReport {
 ///
 /// Memory: about `123 N + (56 + 4 M) S` bytes (32-bit target; e.g. 864 KB at
 /// `N = S = 4096, M = 8`): build large instances in a `Box`, or zeroed in a `static` and
-/// set up by [`SmcPhdTbd::reconfigure`].
+/// set up by [`Detector::configure`].
 #[derive(Debug, Clone)]
 pub struct SmcPhdTbd<const N: usize, const S: usize, const M: usize, const K: usize> {
     cfg: PhdConfig,
