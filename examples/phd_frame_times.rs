@@ -14,32 +14,11 @@ use faint_core::detect::Detector;
 use faint_core::rng::Rng;
 use faint_host::scenario::phd::{HostFilter, SixTargets, Variant};
 
-#[repr(C)]
-struct Timespec {
-    tv_sec: i64,
-    tv_nsec: i64,
-}
-
-extern "C" {
-    fn clock_gettime(clock: i32, ts: *mut Timespec) -> i32;
-}
-
-/// This thread's CPU time in ns: `clock_gettime(CLOCK_THREAD_CPUTIME_ID)` (Linux, 64-bit),
-/// exact to the ns (`/proc/thread-self/schedstat`, used by the bench for the mean, only
-/// advances at scheduler ticks, so single frames read in multiples of ~4 ms).
+/// This thread's CPU time in ns (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`, exact to the
+/// ns; `/proc/thread-self/schedstat`, used by the bench for the mean, only advances at
+/// scheduler ticks, so single frames read in multiples of ~4 ms).
 fn thread_cpu_ns() -> u64 {
-    const CLOCK_THREAD_CPUTIME_ID: i32 = 3;
-    let mut ts = Timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `clock_gettime` writes one `struct timespec` (two 64-bit fields on
-    // x86_64/aarch64 Linux) to a valid pointer.
-    let rc = unsafe { clock_gettime(CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    if rc != 0 {
-        return 0;
-    }
-    ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64
+    (faint_host::timing::thread_cpu_seconds() * 1e9) as u64
 }
 
 fn run() {

@@ -11,6 +11,7 @@
 //! - [`scenario`]: one module per paper's scene (presets are data).
 //! - [`reproduce`]: one module per paper, behind `faint reproduce <name>`.
 //! - [`detect`]: every detector on a user's files, behind `faint detect <name>`.
+//! - [`timing`]: this thread's CPU time, for measurements on a shared machine.
 //! - [`simulate`]: a preset's frames and truth as files, behind `faint simulate <scenario>`.
 
 pub mod analysis;
@@ -21,3 +22,4 @@ pub mod reproduce;
 pub mod scenario;
 pub mod simulate;
 pub mod stats;
+pub mod timing;

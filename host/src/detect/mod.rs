@@ -17,7 +17,6 @@
 //! truth file `gospa.csv` (per-frame GOSPA, alpha = 2, with its decomposition).
 
 use std::path::Path;
-use std::time::Instant;
 
 use anyhow::{anyhow, bail, ensure, Context, Result};
 use faint_core::detect::bernoulli::BernoulliTbd;
@@ -38,6 +37,7 @@ use crate::montecarlo::progress_bar;
 use crate::reproduce::mht::{Classic, Mht};
 use crate::scenario::mht::SeaClutter;
 use crate::scenario::phd::{HostFilter, SixTargets, Variant};
+use crate::timing::thread_cpu_seconds as cpu;
 
 mod output;
 
@@ -149,11 +149,13 @@ pub struct Outcome {
     /// Indices into the state of the position compared with a truth file (empty: the
     /// detector reports no positions).
     pub position: &'static [usize],
-    /// Seconds spent reading and checking the input.
+    /// CPU seconds spent reading and checking the input (and the configuration).
     pub read_seconds: f64,
-    /// Seconds spent in the detector's `step` calls.
+    /// CPU seconds spent in the detector's `step` calls (the frame loop's CPU time less
+    /// the collection).
     pub detector_seconds: f64,
-    /// Seconds spent collecting its detections and reports.
+    /// Seconds spent collecting its detections and reports (wall time of the short
+    /// intervals between steps: a CPU-time call per frame would cost more than they do).
     pub collect_seconds: f64,
 }
 
@@ -404,9 +406,9 @@ where
     let mut rows = Vec::new();
     let mut reports = Vec::with_capacity(if keep_reports { n } else { 0 });
     let mut collect = 0.0f64;
-    let t0 = Instant::now();
+    let t0 = cpu();
     let res = run_frames(det, frames, |k, det, report| {
-        let t = Instant::now();
+        let t = std::time::Instant::now();
         for d in det.detections() {
             rows.push(Row {
                 frame: k,
@@ -424,7 +426,7 @@ where
         }
         collect += t.elapsed().as_secs_f64();
     });
-    let total = t0.elapsed().as_secs_f64();
+    let total = cpu() - t0;
     pb.finish_and_clear();
     let frames = res.map_err(|e| anyhow!("{}: frame {}: {}", input.display(), e.frame, e.error))?;
     Ok(Outcome {
@@ -494,13 +496,13 @@ const XY_POSITION: &[usize] = &[0, 1];
 const PHD_POSITION: &[usize] = &[0, 2];
 
 fn run_crpf(req: &Request) -> Result<Outcome> {
-    let t = Instant::now();
+    let t = cpu();
     let file: Particles<CrpfConfig> = load(req, find_default("crpf"), |f: &Particles<_>| {
         particles_ok(f.particles)?;
         valid(&f.config)
     })?;
     let frames = doppler_input(req, file.config.model.bins)?;
-    let read = t.elapsed().as_secs_f64();
+    let read = cpu() - t;
     let mut out = with_particles!(file.particles, CrpfTbd, |det| {
         let mut det = det;
         det.configure(&file.config, req.seed)
@@ -519,7 +521,7 @@ fn run_crpf(req: &Request) -> Result<Outcome> {
 }
 
 fn run_gauss(req: &Request, name: &'static str) -> Result<Outcome> {
-    let t = Instant::now();
+    let t = cpu();
     let file: GaussFile = load(req, default_gauss, |f: &GaussFile| {
         particles_ok(f.particles)?;
         if f.estimate_noise {
@@ -539,7 +541,7 @@ fn run_gauss(req: &Request, name: &'static str) -> Result<Outcome> {
         cfg.noise_var = estimate_noise_variance(frame_slices(&frames), bins)
             .map_err(|e| anyhow!("{}: noise variance: {e}", req.input.display()))?;
     }
-    let read = t.elapsed().as_secs_f64();
+    let read = cpu() - t;
     macro_rules! go {
         ($ty:ident) => {
             with_particles!(file.particles, $ty, |det| {
@@ -577,7 +579,7 @@ fn find_default(name: &str) -> fn() -> String {
 }
 
 fn run_mht(req: &Request) -> Result<Outcome> {
-    let t = Instant::now();
+    let t = cpu();
     let file: Plain<MhtConfig> = load(req, find_default("mht"), |f: &Plain<MhtConfig>| {
         valid(&f.config)?;
         ensure!(
@@ -588,7 +590,7 @@ fn run_mht(req: &Request) -> Result<Outcome> {
         Ok(())
     })?;
     let scans = read_plots(req.input)?;
-    let read = t.elapsed().as_secs_f64();
+    let read = cpu() - t;
     let mut det = Box::new(Mht::unconfigured());
     det.configure(&file.config, req.seed)
         .map_err(|e| anyhow!("{e}"))?;
@@ -605,14 +607,14 @@ fn run_mht(req: &Request) -> Result<Outcome> {
 }
 
 fn run_classic(req: &Request) -> Result<Outcome> {
-    let t = Instant::now();
+    let t = cpu();
     let file: Plain<ClassicHoughConfig> = load(
         req,
         find_default("hough-classic"),
         |f: &Plain<ClassicHoughConfig>| valid(&f.config),
     )?;
     let scans = read_plots(req.input)?;
-    let read = t.elapsed().as_secs_f64();
+    let read = cpu() - t;
     let mut det = Box::new(Classic::new(file.config).map_err(|e| anyhow!("{e}"))?);
     det.configure(&file.config, req.seed)
         .map_err(|e| anyhow!("{e}"))?;
@@ -629,7 +631,7 @@ fn run_classic(req: &Request) -> Result<Outcome> {
 }
 
 fn run_phd(req: &Request, name: &'static str, v: Variant) -> Result<Outcome> {
-    let t = Instant::now();
+    let t = cpu();
     let default = match v {
         Variant::PhdTbd => find_default("phd-tbd"),
         Variant::PsoKMeans => find_default("pso-phd-kmeans"),
@@ -646,7 +648,7 @@ fn run_phd(req: &Request, name: &'static str, v: Variant) -> Result<Outcome> {
         &cubes.shape[1..],
         want
     );
-    let read = t.elapsed().as_secs_f64();
+    let read = cpu() - t;
     let cfg = file.config;
     // Large filter: built on a thread with a big stack, then boxed.
     let mut det = std::thread::Builder::new()
