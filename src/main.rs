@@ -40,6 +40,8 @@ enum Reproduce {
     Mht(faint::host::reproduce::mht::Args),
     /// Pei et al. 2019: PSO-PHD-TBD versus PHD-TBD (Tables 2-4, Fig. 3-5).
     Psophd(faint::host::reproduce::psophd::Args),
+    /// CBMeMBer TBD, joint Doppler / micro-Doppler vs Doppler-only (rotor-UAV paper, 2023).
+    Cbmember(faint::host::reproduce::cbmember::Args),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -60,6 +62,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             Reproduce::Crpf(a) => faint::host::reproduce::crpf::run(&a),
             Reproduce::Mht(a) => faint::host::reproduce::mht::run(&a),
             Reproduce::Psophd(a) => faint::host::reproduce::psophd::run(&a),
+            Reproduce::Cbmember(a) => faint::host::reproduce::cbmember::run(&a),
         },
     }
 }

@@ -383,7 +383,7 @@ struct Component<const P: usize> {
 /// Memory: about `C (32 P + 48) + 6 P + 4 S + 9 KB` bytes (e.g. 170 KB at `C = 4`,
 /// `P = 1000`, `S = 8192`). Build large instances in a `Box` or zeroed in a `static` and
 /// set up by [`Detector::configure`].
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct CbmemberTbd<const C: usize, const P: usize, const S: usize, F: ?Sized = [f32]> {
     cfg: CbmemberConfig,
     comps: [Component<P>; C],
@@ -401,6 +401,30 @@ pub struct CbmemberTbd<const C: usize, const P: usize, const S: usize, F: ?Sized
     reported: [u16; C],
     n_reported: usize,
     _frame: PhantomData<fn(&F)>,
+}
+
+// By hand: a derive would ask `F: Clone` of the (unsized) frame type.
+impl<const C: usize, const P: usize, const S: usize, F: ?Sized> Clone for CbmemberTbd<C, P, S, F> {
+    fn clone(&self) -> Self {
+        Self {
+            cfg: self.cfg,
+            comps: self.comps.clone(),
+            lw: self.lw,
+            anc: self.anc,
+            blocks: self.blocks,
+            h: self.h,
+            p: self.p,
+            kernel: self.kernel,
+            dq: self.dq,
+            c0: self.c0,
+            rng: self.rng.clone(),
+            next_id: self.next_id,
+            frames: self.frames,
+            reported: self.reported,
+            n_reported: self.n_reported,
+            _frame: PhantomData,
+        }
+    }
 }
 
 /// Likelihood context of one frame.
