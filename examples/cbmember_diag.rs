@@ -97,6 +97,20 @@ fn main() {
                     _ => Some(e),
                 },
             );
+            if rep.reported > 1 && std::env::var("DIAG_DUP").is_ok() {
+                for k2 in 0..rep.reported {
+                    if let Some(e) = f.reported(k2) {
+                        line += &format!(
+                            " [{name} dup id {} age {} r {:.3} dr {:.2} dv {:.2}]",
+                            e.id,
+                            e.age,
+                            e.existence,
+                            e.state[0] as f64 - t.range,
+                            e.state[1] as f64 - t.velocity
+                        );
+                    }
+                }
+            }
             if let Some(e) = best {
                 line += &format!(
                     " {name}: r {:.3} n {} dr {:6.2} dv {:5.2} V {:4.1} w {:.3} comps {} parts {}|",

@@ -60,21 +60,26 @@ pub struct Args {
     #[arg(long, default_value = "out/cbmember")]
     pub out: PathBuf,
     /// Master seed.
-    #[arg(long, default_value_t = 2023)]
+    #[arg(long, default_value_t = 2024)]
     pub seed: u64,
     /// Sets to run (default all): base (Fig. 7, 8, 11), blades (Fig. 9), omega (Fig. 10),
-    /// fa (target-free), ablation (B estimated, u8 map), physical, timing (Table 3).
+    /// fa (target-free), ablation (B estimated, u8 map), merge (the narrower merge gate
+    /// [2 m, 0.5 m/s]), known (micro-Doppler parameters known), physical, timing (Table 3).
     #[arg(long, value_delimiter = ',')]
     pub sets: Option<Vec<String>>,
     /// CI mode: small defaults (2 runs, two SNR points, 700 particles, 10 timing
     /// frames); never overrides a value given on the command line.
     #[arg(long)]
     pub quick: bool,
+    /// A `curves.csv` of an earlier run whose sets not run now are merged into this run's
+    /// CSV, plots and summary (e.g. the base set at 100 runs, the others at 50).
+    #[arg(long)]
+    pub previous: Option<PathBuf>,
 }
 
 /// Every set name accepted by `--sets`.
-pub const SETS: [&str; 7] = [
-    "base", "blades", "omega", "fa", "ablation", "physical", "timing",
+pub const SETS: [&str; 9] = [
+    "base", "blades", "omega", "fa", "ablation", "merge", "known", "physical", "timing",
 ];
 
 /// Arguments after `--quick` defaults.
@@ -203,7 +208,7 @@ struct RunStats {
 }
 
 /// One point of a curve (a CSV row).
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub struct Row {
     /// Set and curve.
     pub set: String,
@@ -531,6 +536,16 @@ pub fn run(args: &Args) -> Result<()> {
         .context("thread pool")?;
     let want = |s: &str| e.sets.iter().any(|x| x == s);
     let d = &args.out;
+    let previous: Vec<Row> = match &args.previous {
+        Some(p) => {
+            let mut r = csv::Reader::from_path(p)
+                .with_context(|| format!("--previous: cannot read {}", p.display()))?;
+            r.deserialize()
+                .collect::<std::result::Result<_, _>>()
+                .with_context(|| format!("--previous: {} is not a curves.csv", p.display()))?
+        }
+        None => Vec::new(),
+    };
     let mut rows: Vec<Row> = Vec::new();
     let mut fig11: Vec<usize> = e.particles.clone();
     fig11.sort_unstable();
@@ -627,6 +642,52 @@ pub fn run(args: &Args) -> Result<()> {
         )?);
         save(&rows)?;
     }
+    if want("merge") {
+        // The narrower merge gate of the first runs, [2 m, 0.5 m/s]: a birth confirmed
+        // in one frame 2-3 m behind the receding target is a second report.
+        rows.extend(run_set(
+            "merge",
+            &e.snrs,
+            e.runs,
+            args.seed,
+            &RotorUav::new,
+            &|sc| {
+                let narrow = |mut f: FilterSpec| {
+                    f.cfg.merge_gate = [2.0, 0.5];
+                    f.name = format!("{} merge gate 2 m 0.5 mps", f.name);
+                    f
+                };
+                vec![narrow(joint(sc, 1500)), narrow(doppler(sc, 1500))]
+            },
+            &pool,
+        )?);
+        save(&rows)?;
+    }
+    if want("known") {
+        // The paper's comparison assumes the micro-Doppler parameters known: births with
+        // the true V, omega and phase (referenced to frame 0), no V / omega noise.
+        rows.extend(run_set(
+            "known",
+            &e.snrs,
+            e.runs,
+            args.seed,
+            &RotorUav::new,
+            &|sc| {
+                let mut f = joint(sc, 1500);
+                let b = &mut f.cfg.birth;
+                b.blade_speed = [sc.blade_speed as f32; 2];
+                b.omega = [sc.omega as f32; 2];
+                b.theta = [sc.theta0 as f32; 2];
+                b.phase_from_frame0 = true;
+                f.cfg.process.blade_speed = 0.0;
+                f.cfg.process.omega = 0.0;
+                f.name = "joint 1500 micro-Doppler known".into();
+                vec![f]
+            },
+            &pool,
+        )?);
+        save(&rows)?;
+    }
     if want("physical") {
         rows.extend(run_set(
             "physical",
@@ -657,16 +718,28 @@ pub fn run(args: &Args) -> Result<()> {
     } else {
         Vec::new()
     };
+    // Earlier sets that this run did not redo.
+    let ran: Vec<String> = rows.iter().map(|r| r.set.clone()).collect();
+    rows.extend(previous.into_iter().filter(|r| !ran.contains(&r.set)));
     save(&rows)?;
-    plots(d, &rows, &fig11, e.runs)?;
-    let md = summary(&rows, &timing_rows, e.runs);
+    plots(d, &rows, &fig11)?;
+    let md = summary(&rows, &timing_rows);
     io::write_text(d.join("summary.md"), &md)?;
     println!("{md}");
     Ok(())
 }
 
-fn plots(d: &std::path::Path, rows: &[Row], fig11: &[usize], runs: usize) -> Result<()> {
+fn plots(d: &std::path::Path, rows: &[Row], fig11: &[usize]) -> Result<()> {
     let pd = |r: &Row| r.pd;
+    // Runs per point of a set (the sets of a merged run can differ).
+    let n = |set: &str| {
+        rows.iter()
+            .filter(|r| r.set == set)
+            .map(|r| r.runs)
+            .max()
+            .unwrap_or(0)
+    };
+    let runs = n("base");
     let has = |set: &str| rows.iter().any(|r| r.set == set);
     if has("base") {
         io::plot::line_chart(
@@ -730,7 +803,10 @@ fn plots(d: &std::path::Path, rows: &[Row], fig11: &[usize], runs: usize) -> Res
     if has("blades 3") {
         io::plot::line_chart(
             d.join("fig9_blades.svg"),
-            &format!("Fig. 9: Pd vs SNR by blade count (joint 1500), {runs} runs"),
+            &format!(
+                "Fig. 9: Pd vs SNR by blade count (joint 1500), {} runs (B = 2: {runs})",
+                n("blades 3")
+            ),
             "SNR (dB, eq. 19)",
             "Pd",
             &[
@@ -743,7 +819,10 @@ fn plots(d: &std::path::Path, rows: &[Row], fig11: &[usize], runs: usize) -> Res
     if has("omega 0.04 pi") {
         io::plot::line_chart(
             d.join("fig10_omega.svg"),
-            &format!("Fig. 10: Pd vs SNR by rotor rate (joint 1500), {runs} runs"),
+            &format!(
+                "Fig. 10: Pd vs SNR by rotor rate (joint 1500), {} runs (0.06 pi: {runs})",
+                n("omega 0.04 pi")
+            ),
             "SNR (dB, eq. 19)",
             "Pd",
             &[
@@ -756,7 +835,10 @@ fn plots(d: &std::path::Path, rows: &[Row], fig11: &[usize], runs: usize) -> Res
     if has("ablation") {
         io::plot::line_chart(
             d.join("ablation_pd.svg"),
-            &format!("Ablations: B estimated, u8 map (joint 1500), {runs} runs"),
+            &format!(
+                "Ablations: B estimated, u8 map (joint 1500), {} runs (base: {runs})",
+                n("ablation")
+            ),
             "SNR (dB, eq. 19)",
             "Pd",
             &[
@@ -770,6 +852,72 @@ fn plots(d: &std::path::Path, rows: &[Row], fig11: &[usize], runs: usize) -> Res
                 ),
                 series(rows, "ablation", "joint 1500 u8 map", "u8 map", pd),
                 series(rows, "base", "Doppler-only 1500", "Doppler-only", pd),
+            ],
+        )?;
+    }
+    if has("known") {
+        io::plot::line_chart(
+            d.join("known_pd.svg"),
+            &format!(
+                "Micro-Doppler known (the paper's assumption): Pd, {} runs (base: {runs})",
+                n("known")
+            ),
+            "SNR (dB, eq. 19)",
+            "Pd",
+            &[
+                series(
+                    rows,
+                    "known",
+                    "joint 1500 micro-Doppler known",
+                    "joint, V / omega / theta known",
+                    pd,
+                ),
+                series(
+                    rows,
+                    "base",
+                    "joint 1500",
+                    "joint, V / omega / theta estimated",
+                    pd,
+                ),
+                series(rows, "base", "Doppler-only 1500", "Doppler-only", pd),
+            ],
+        )?;
+    }
+    if has("merge") {
+        io::plot::line_chart(
+            d.join("merge_ospa.svg"),
+            &format!("Merge gate: mean OSPA, {} runs (base: {runs})", n("merge")),
+            "SNR (dB, eq. 19)",
+            "mean OSPA",
+            &[
+                series(
+                    rows,
+                    "base",
+                    "joint 1500",
+                    "joint, gate [3 m, 5 m/s] (preset)",
+                    |r| r.ospa,
+                ),
+                series(
+                    rows,
+                    "merge",
+                    "joint 1500 merge gate 2 m 0.5 mps",
+                    "joint, gate [2 m, 0.5 m/s]",
+                    |r| r.ospa,
+                ),
+                series(
+                    rows,
+                    "base",
+                    "Doppler-only 1500",
+                    "Doppler-only, gate [3 m, 5 m/s] (preset)",
+                    |r| r.ospa,
+                ),
+                series(
+                    rows,
+                    "merge",
+                    "Doppler-only 1500 merge gate 2 m 0.5 mps",
+                    "Doppler-only, gate [2 m, 0.5 m/s]",
+                    |r| r.ospa,
+                ),
             ],
         )?;
     }
@@ -790,7 +938,10 @@ fn plots(d: &std::path::Path, rows: &[Row], fig11: &[usize], runs: usize) -> Res
             .collect();
         io::plot::line_chart(
             d.join("physical_pd.svg"),
-            &format!("Physical generator (eq. 11 + FFT): Pd vs SNR, {runs} runs"),
+            &format!(
+                "Physical generator (eq. 11 + FFT): Pd vs SNR, {} runs",
+                n("physical")
+            ),
             "SNR (dB, peak pixel, eq. 19)",
             "Pd",
             &s,
@@ -799,7 +950,10 @@ fn plots(d: &std::path::Path, rows: &[Row], fig11: &[usize], runs: usize) -> Res
     if has("target-free") {
         io::plot::line_chart(
             d.join("false_alarms.svg"),
-            &format!("Target-free runs: reported components per frame, {runs} runs"),
+            &format!(
+                "Target-free runs: reported components per frame, {} runs",
+                n("target-free")
+            ),
             "filter gain set for SNR (dB)",
             "false alarms per frame",
             &[
@@ -820,8 +974,16 @@ fn plots(d: &std::path::Path, rows: &[Row], fig11: &[usize], runs: usize) -> Res
 }
 
 /// The Markdown summary: our numbers next to the paper's.
-fn summary(rows: &[Row], timing: &[TimingRow], runs: usize) -> String {
+fn summary(rows: &[Row], timing: &[TimingRow]) -> String {
     let mut s = String::new();
+    let n = |set: &str| {
+        rows.iter()
+            .filter(|r| r.set == set)
+            .map(|r| r.runs)
+            .max()
+            .unwrap_or(0)
+    };
+    let runs = n("base");
     let at = |set: &str, name: &str, lvl: f64| snr_at_pd(&curve(rows, set, name), lvl);
     if rows.iter().any(|r| r.set == "base") {
         s.push_str(&format!(
@@ -865,6 +1027,7 @@ fn summary(rows: &[Row], timing: &[TimingRow], runs: usize) -> String {
             t.push(vec![
                 set.to_string(),
                 name.to_string(),
+                n(set).to_string(),
                 fmt_db(x.snr_db),
                 format!("[{}, {}]", fmt_db(x.lo_db), fmt_db(x.hi_db)),
                 fmt_db(gain),
@@ -876,6 +1039,7 @@ fn summary(rows: &[Row], timing: &[TimingRow], runs: usize) -> String {
             &[
                 "set",
                 "filter",
+                "runs per point",
                 "SNR at Pd 0.9 (dB)",
                 "band (CP bounds)",
                 "gain over Doppler-only (dB)",
@@ -892,11 +1056,15 @@ fn summary(rows: &[Row], timing: &[TimingRow], runs: usize) -> String {
             .map(|r| r.snr_db)
             .fold(f64::NEG_INFINITY, f64::max);
         let mut t = Vec::new();
-        for r in rows.iter().filter(|r| r.set == "base" && r.snr_db == top) {
+        for r in rows
+            .iter()
+            .filter(|r| (r.set == "base" || r.set == "merge") && r.snr_db == top)
+        {
             t.push(vec![
-                r.curve.clone(),
+                format!("{} ({})", r.curve, r.set),
                 format!("{}", r.snr_db),
                 format!("{:.3}", r.pd),
+                format!("{:.3}", r.reported_per_frame),
                 format!("{:.3}", r.ospa),
                 format!("{:.3}", r.ospa_after_burn_in),
                 format!("{:.3}", r.rmse_range_m),
@@ -912,6 +1080,7 @@ fn summary(rows: &[Row], timing: &[TimingRow], runs: usize) -> String {
                 "filter",
                 "SNR (dB)",
                 "Pd",
+                "reported per frame",
                 "mean OSPA, all frames",
                 "mean OSPA, after burn-in",
                 "RMSE range (m)",
@@ -923,7 +1092,7 @@ fn summary(rows: &[Row], timing: &[TimingRow], runs: usize) -> String {
     }
     let fa: Vec<&Row> = rows.iter().filter(|r| r.set == "target-free").collect();
     if !fa.is_empty() {
-        s.push_str(&format!("\n### False alarms per frame, target-free runs ({runs} runs, after burn-in; paper: none given)\n\n"));
+        s.push_str(&format!("\n### False alarms per frame, target-free runs ({} runs per point, after burn-in; paper: none given)\n\n", n("target-free")));
         let t: Vec<Vec<String>> = fa
             .iter()
             .map(|r| {

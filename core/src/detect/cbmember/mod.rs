@@ -25,10 +25,12 @@
 //! 5. **resample** (step 16) each component to `L = clamp(round(r L_max), L_min, L_max)`
 //!    particles (Vo, Vo, Cantoni 2009, §V), systematic, equal weights;
 //! 6. **prune and merge**: a component with `r` below `prune_below` is dropped; two whose
-//!    estimates lie within `merge_gate` (range, velocity) are one: the one with the
-//!    larger existence is kept, with its own particles and existence (`max`, not a sum:
-//!    births placed every frame on the same prior would otherwise add up their small
-//!    existences); capacity: a birth takes a free slot, else the slot of the weakest
+//!    estimates lie within `merge_gate` (range, velocity; the preset's is one spread,
+//!    `[zeta_r, zeta_v]`: their supports overlap, which the separability assumption of the
+//!    image-observation filter, Vo, Vo, Pham, Suter 2010, excludes for two targets) are
+//!    one: the one with the larger existence is kept, with its own particles and
+//!    existence (`max`, not a sum: births placed every frame on the same prior would
+//!    otherwise add up their small existences); capacity: a birth takes a free slot, else the slot of the weakest
 //!    component if that one's existence is below the birth's, else it is skipped
 //!    ([`CbmemberReport::birth`]);
 //! 7. **report** the components whose existence exceeds `report_threshold`, each with a
@@ -136,6 +138,10 @@ pub struct BirthDensity {
     pub omega: [f32; 2],
     /// `theta ~ U[lo, hi]` (rad).
     pub theta: [f32; 2],
+    /// `theta` is the phase at frame 0: a birth on frame `k` gets
+    /// `theta + omega k eps` (a rotor-phase prior referenced to the first frame; with
+    /// point ranges for `V`, `omega`, `theta` this is the paper's "micro-Doppler known").
+    pub phase_from_frame0: bool,
 }
 
 /// Runtime configuration.
@@ -200,8 +206,8 @@ impl CbmemberConfig {
     /// `B = 2` known, `p_S = 0.9`, `L_max = 1500`, `L_min = 450`, births of existence 0.01
     /// with 450 particles from `r ~ N(20 010, 2^2)`, `v ~ N(1, 0.4^2)`,
     /// `rho ~ N(1, 0.1^2)`, `V ~ U[9, 11]`, `omega ~ U[0.03 pi, 0.09 pi]`,
-    /// `theta ~ U[0, 2 pi)`, blocked likelihood with 16-bin blocks, merge gate
-    /// `[2 m, 0.5 m/s]`, report threshold 0.5.
+    /// `theta ~ U[0, 2 pi)`, blocked likelihood with 16-bin blocks, merge gate of one
+    /// spread `[3 m, 5 m/s]`, report threshold 0.5.
     pub fn rotor_uav() -> Self {
         Self {
             geometry: RdGeometry {
@@ -238,13 +244,14 @@ impl CbmemberConfig {
                 blade_speed: [9.0, 11.0],
                 omega: [0.03 * math::PI, 0.09 * math::PI],
                 theta: [0.0, 2.0 * math::PI],
+                phase_from_frame0: false,
             },
             blades: 2,
             estimate_blades: false,
             max_particles: 1500,
             min_particles: 450,
             prune_below: 1.0e-3,
-            merge_gate: [2.0, 0.5],
+            merge_gate: [3.0, 5.0],
             report_threshold: 0.5,
             quant_step: 0.05,
         }
@@ -578,23 +585,24 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
         }
     }
 
-    /// One particle from the birth density.
-    fn birth_particle(cfg: &CbmemberConfig, rng: &mut Rng) -> [f32; DIM] {
+    /// One particle from the birth density (`frame`: index of the frame being processed).
+    fn birth_particle(cfg: &CbmemberConfig, frame: u32, rng: &mut Rng) -> [f32; DIM] {
         let b = &cfg.birth;
         let blades = if cfg.estimate_blades {
             1 + rng.below(MAX_BLADES as u32)
         } else {
             cfg.blades
         };
-        [
-            rng.gaussian(b.range[0], b.range[1]),
-            rng.gaussian(b.velocity[0], b.velocity[1]),
-            rng.gaussian(b.rho[0], b.rho[1]).abs(),
-            rng.uniform_range(b.blade_speed[0], b.blade_speed[1]),
-            rng.uniform_range(b.omega[0], b.omega[1]),
-            wrap_angle(rng.uniform_range(b.theta[0], b.theta[1])),
-            blades as f32,
-        ]
+        let r = rng.gaussian(b.range[0], b.range[1]);
+        let v = rng.gaussian(b.velocity[0], b.velocity[1]);
+        let rho = rng.gaussian(b.rho[0], b.rho[1]).abs();
+        let spread = rng.uniform_range(b.blade_speed[0], b.blade_speed[1]);
+        let omega = rng.uniform_range(b.omega[0], b.omega[1]);
+        let mut theta = rng.uniform_range(b.theta[0], b.theta[1]);
+        if b.phase_from_frame0 {
+            theta += omega * cfg.dt * frame as f32;
+        }
+        [r, v, rho, spread, omega, wrap_angle(theta), blades as f32]
     }
 
     /// The slot a birth goes to: a free one, else the weakest component's if its
@@ -662,7 +670,7 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
             if let Some(c) = self.comps.get_mut(k) {
                 let n = cfg.birth.particles.min(P);
                 for x in c.x.iter_mut().take(n) {
-                    *x = Self::birth_particle(&cfg, &mut self.rng);
+                    *x = Self::birth_particle(&cfg, self.frames, &mut self.rng);
                 }
                 let w = 1.0 / n.max(1) as f32;
                 c.w.iter_mut().take(n).for_each(|v| *v = w);
