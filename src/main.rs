@@ -117,6 +117,8 @@ enum Reproduce {
     /// Pei et al. 2019: PSO-PHD-TBD versus PHD-TBD (Tables 2-4, Fig. 3-5).
     #[command(alias = "psophd")]
     Phd(faint::host::reproduce::phd::Args),
+    /// CBMeMBer TBD, joint Doppler / micro-Doppler vs Doppler-only (rotor-UAV paper, 2023).
+    Cbmember(faint::host::reproduce::cbmember::Args),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -156,6 +158,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             Reproduce::Crpf(a) => faint::host::reproduce::crpf::run(&a),
             Reproduce::Mht(a) => faint::host::reproduce::mht::run(&a),
             Reproduce::Phd(a) => faint::host::reproduce::phd::run(&a),
+            Reproduce::Cbmember(a) => faint::host::reproduce::cbmember::run(&a),
         },
     }
 }

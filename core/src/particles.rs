@@ -390,6 +390,57 @@ pub fn gather_in_place<S: Copy, I: ParticleIndex>(states: &mut [S], ancestors: &
     Ok(())
 }
 
+/// [`gather_in_place`] when the particle count changes (a separate loop: the fixed-count one
+/// keeps its bounds checks provably elided, 28 instructions per particle on the M4): the `n_old` old states are
+/// `states[..n_old]`, and `states[j] = old states[ancestors[j]]` is written for
+/// `j < ancestors.len()` (sorted ancestors below `n_old`; `states` holds at least
+/// `max(n_old, ancestors.len())` entries). The same two passes are correct: a slot
+/// `k = a_j < j` has `a_k <= k` (sorted), so the ascending pass left it unchanged, and slots
+/// at or above `n_old` are never read. Errors as [`gather_in_place`].
+pub fn gather_resized_in_place<S: Copy, I: ParticleIndex>(
+    states: &mut [S],
+    n_old: usize,
+    ancestors: &[I],
+) -> Result<()> {
+    let n = ancestors.len();
+    if states.len() < n_old.max(n) {
+        return Err(Error::LengthMismatch {
+            expected: n_old.max(n),
+            got: states.len(),
+        });
+    }
+    let mut prev = 0usize;
+    for a in ancestors {
+        let a = a.to_usize();
+        if a >= n_old {
+            return Err(Error::IndexOutOfRange);
+        }
+        if a < prev {
+            return Err(Error::UnsortedAncestors);
+        }
+        prev = a;
+    }
+    // `get` instead of indexing: the bounds were checked above, but this keeps the
+    // function provably panic-free at link time (firmware `panic-never` check).
+    for (j, a) in ancestors.iter().enumerate() {
+        let a = a.to_usize();
+        if let (true, Some(&s)) = (a >= j, states.get(a)) {
+            if let Some(d) = states.get_mut(j) {
+                *d = s;
+            }
+        }
+    }
+    for (j, a) in ancestors.iter().enumerate().rev() {
+        let a = a.to_usize();
+        if let (true, Some(&s)) = (a < j, states.get(a)) {
+            if let Some(d) = states.get_mut(j) {
+                *d = s;
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Effective sample size `(sum w)^2 / sum w^2` of non-negative weights (normalised or
 /// not). Returns 0 for an empty or all-zero slice, and for NaN/inf inputs.
 pub fn effective_sample_size(weights: &[f32]) -> f32 {
@@ -516,6 +567,27 @@ mod tests {
         assert_eq!(
             gather_in_place(&mut s, &[1u16, 0, 2, 3, 4, 5, 6, 7]),
             Err(Error::UnsortedAncestors)
+        );
+    }
+
+    #[test]
+    fn gather_resized_matches_copy() {
+        for (n_old, anc) in [
+            (8usize, &[0u16, 0, 1, 4, 4, 4, 6, 7, 7, 7, 7][..]),
+            (8, &[2u16, 2, 5][..]),
+            (3, &[0u16, 1, 1, 1, 2, 2][..]),
+        ] {
+            let mut s: Vec<u32> = (0..n_old.max(anc.len()) as u32).map(|i| 10 + i).collect();
+            let old = s.clone();
+            gather_resized_in_place(&mut s, n_old, anc).unwrap();
+            for (j, &a) in anc.iter().enumerate() {
+                assert_eq!(s[j], old[a as usize]);
+            }
+        }
+        let mut s = [0u32; 4];
+        assert_eq!(
+            gather_resized_in_place(&mut s, 2, &[0u16, 2]),
+            Err(Error::IndexOutOfRange)
         );
     }
 

@@ -13,6 +13,7 @@
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
 
+mod cbmember;
 mod crpf;
 mod harness;
 mod mht;
@@ -32,6 +33,7 @@ fn main() -> ! {
     mht::run();
     crpf::run();
     phd::run();
+    cbmember::run();
     hprintln!();
     hprintln!(
         "static RAM of this image (.data + .bss, all rows): {} bytes",

@@ -32,6 +32,7 @@
 
 use core::fmt;
 
+pub mod cbmember;
 pub mod crpf;
 pub mod phd;
 
@@ -103,6 +104,7 @@ pub fn cases(emit: &mut dyn FnMut(&str, &[u32])) {
     mht::cases(emit);
     crpf::cases(emit);
     phd::cases(emit);
+    cbmember::cases(emit);
 }
 
 fn bits<const K: usize>(mut f: impl FnMut() -> f32) -> [u32; K] {

@@ -6,7 +6,9 @@
 //! | [`pf_tbd`], [`bernoulli`], [`pf_lrt`] | PF-TBD, JOTT, PF-LRT (its comparators) | `[Complex32]` |
 //! | [`mht`] | MHT-TBD (Bao et al. 2022), classic Hough TBD | `[Plot]`, one scan |
 //! | [`phd`] | SMC-PHD TBD with the PSO step (Pei et al. 2019) | `[f32]`, one power cube |
+//! | [`cbmember`] | CBMeMBer TBD, joint Doppler / micro-Doppler (rotor-UAV paper, 2023) | `[f32]` power, `[Complex32]` or `[u8]` range-Doppler map |
 pub mod bernoulli;
+pub mod cbmember;
 pub mod crpf;
 mod gauss_cloud;
 mod interface;

@@ -2,3 +2,4 @@
 pub mod doppler;
 pub mod plot;
 pub mod power_cube;
+pub mod range_doppler;

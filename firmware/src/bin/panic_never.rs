@@ -1,5 +1,6 @@
-//! Link-time proof that the `faint-core` primitives contain no reachable panic (in the
-//! spirit of japaric's `panic-never`): the panic handler calls a function that does not
+//! Link-time proof that the `faint-core` primitives and the CBMeMBer filter
+//! (`configure`, `step` on `f32` and `u8` maps, `reset`, detections) contain no reachable
+//! panic (in the spirit of japaric's `panic-never`): the panic handler calls a function that does not
 //! exist, so if any panic path (bounds check, overflow check, `unwrap`, slice index...)
 //! survives optimisation, **the link fails** with an undefined reference to
 //! `faint_core_panic_path_survived`. Only meaningful with the `firmware` profile (fat LTO):
@@ -18,18 +19,31 @@ use core::hint::black_box;
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hio};
+use faint_core::detect::cbmember::{CbmemberConfig, CbmemberTbd, Likelihood};
+use faint_core::detect::Detector;
 use faint_core::existence::ExistenceMarkov;
 use faint_core::math;
+use faint_core::model::range_doppler::{PointModel, RdGeometry};
 use faint_core::particles::{self, Scheme};
 use faint_core::rng::Rng;
 
 const N: usize = 1000;
 
+/// CBMeMBer TBD on a 32 x 128 map (16-bin blocks: 256 block sums).
+type Cbm = CbmemberTbd<2, 64, 256>;
+type CbmU8 = CbmemberTbd<2, 64, 256, [u8]>;
+// SAFETY: const-evaluated all-zero value (an invalid zero field is a compile error);
+// `configure` sets it up before use.
+static mut CBM: Cbm = unsafe { core::mem::MaybeUninit::zeroed().assume_init() };
+static mut CBM_U8: CbmU8 = unsafe { core::mem::MaybeUninit::zeroed().assume_init() };
+static mut MAP: [f32; 32 * 128] = [0.0; 32 * 128];
+static mut MAP_U8: [u8; 32 * 128] = [0; 32 * 128];
+
 #[entry]
 fn main() -> ! {
     let ok = run();
     say(if ok {
-        b"panic-never: primitives linked without a panic path and ran ok\n"
+        b"panic-never: primitives and CbmemberTbd linked without a panic path and ran ok\n"
     } else {
         b"panic-never: a primitive returned Err\n"
     });
@@ -102,6 +116,83 @@ fn run() -> bool {
         rng.uniform_range(-1.0, 1.0),
         rng.below(17) as f32,
     ]);
+    ok &= cbmember(&mut rng);
+    ok
+}
+
+/// `configure`, `step` (f32 and u8 maps, blocked and exact likelihoods, joint and
+/// Doppler-only, bad maps), `reset` and the detections of the CBMeMBer filter, on
+/// configurations and maps hidden from the optimiser.
+fn cbmember(rng: &mut Rng) -> bool {
+    // SAFETY: single-threaded, the only references to these statics.
+    let (det, det_u8, map, map_u8) = unsafe {
+        (
+            &mut *core::ptr::addr_of_mut!(CBM),
+            &mut *core::ptr::addr_of_mut!(CBM_U8),
+            &mut *core::ptr::addr_of_mut!(MAP),
+            &mut *core::ptr::addr_of_mut!(MAP_U8),
+        )
+    };
+    let mut cfg = CbmemberConfig::rotor_uav();
+    cfg.geometry = RdGeometry {
+        n_range: 32,
+        n_velocity: 128,
+        range_start: 19_997.5,
+        range_bin: 0.781_25,
+        velocity_start: -4.0,
+        velocity_bin: 0.078_125,
+    };
+    cfg.max_particles = 64;
+    cfg.min_particles = 16;
+    cfg.birth.particles = 32;
+    cfg.gain = 3.0e15;
+    let cfg: CbmemberConfig = black_box(cfg);
+    for (z, q) in map.iter_mut().zip(map_u8.iter_mut()) {
+        *z = 0.18 * rng.exponential();
+        *q = (*z * 100.0) as u8;
+    }
+    let map: &mut [f32] = black_box(&mut map[..]);
+    let map_u8: &[u8] = black_box(&map_u8[..]);
+    let mut ok = det.configure(&cfg, black_box(7)).is_ok();
+    ok &= det_u8.configure(&cfg, black_box(7)).is_ok();
+    let mut score = 0.0f32;
+    for k in 0..black_box(3usize) {
+        ok &= det.step(map).is_ok();
+        ok &= det_u8.step(map_u8).is_ok();
+        for i in 0..black_box(4usize) {
+            if let Some(d) = det.detection(i) {
+                score += d.score + d.state().iter().sum::<f32>();
+            }
+            if let Some(d) = det_u8.detection(i) {
+                score += d.score;
+            }
+        }
+        score += det.detection_count() as f32 + k as f32;
+    }
+    // Bad maps are errors, not panics.
+    let n = black_box(map.len());
+    ok &= det
+        .step(map.get(..n.saturating_sub(1)).unwrap_or(&[]))
+        .is_err();
+    if let Some(p) = map.get_mut(black_box(5)) {
+        *p = f32::NAN;
+    }
+    ok &= det.step(map).is_err();
+    if let Some(p) = map.get_mut(black_box(5)) {
+        *p = 0.1;
+    }
+    let mut other = cfg;
+    other.likelihood = Likelihood::Exact;
+    other.model = PointModel::DopplerOnly;
+    other.estimate_blades = true;
+    ok &= det.configure(&black_box(other), 3).is_ok();
+    ok &= det.step(map).is_ok();
+    det.reset(black_box(9));
+    ok &= det.step(map).is_ok();
+    let mut bad = cfg;
+    bad.noise_var = black_box(0.0);
+    ok &= det.configure(&bad, 1).is_err();
+    black_box(score);
     ok
 }
 

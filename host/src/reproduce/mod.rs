@@ -2,6 +2,7 @@
 //! `faint reproduce <name>`: every one writes CSV, SVG plots and a Markdown table with
 //! the paper's numbers next to ours.
 
+pub mod cbmember;
 pub mod crpf;
 pub mod mht;
 pub mod phd;

@@ -5,6 +5,7 @@
 
 use anyhow::{bail, Result};
 
+pub mod cbmember;
 pub mod crpf;
 pub mod mht;
 pub mod phd;
@@ -13,6 +14,10 @@ pub mod phd;
 type Entry = (&'static str, &'static str, fn() -> serde_json::Value);
 
 const CATALOGUE: &[Entry] = &[(
+    "rotor-uav",
+    "CBMeMBer joint Doppler / micro-Doppler TBD (rotor-UAV paper, 2023): one rotor UAV, 256 x 512 range-Doppler maps, B = 2, 40 frames",
+    cbmember::RotorUav::describe,
+), (
     "othr",
     "sky-wave OTHR, one range cell, Doppler-manoeuvring target, K = m = 32 (Lu et al. 2017)",
     crpf::describe,

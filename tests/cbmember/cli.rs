@@ -1,0 +1,81 @@
+//! `faint reproduce cbmember --quick` runs end to end and writes its outputs; bad
+//! arguments are one-line errors naming the argument; `--quick` never overrides a value
+//! given on the command line.
+
+use std::process::Command;
+
+#[test]
+fn reproduce_cbmember_quick_writes_tables_and_plots() {
+    let dir = std::env::temp_dir().join(format!("faint-cbmember-{}", std::process::id()));
+    let out = Command::new(env!("CARGO_BIN_EXE_faint"))
+        .args([
+            "--quiet",
+            "reproduce",
+            "cbmember",
+            "--quick",
+            "--runs",
+            "1",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .expect("run faint");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let md = std::fs::read_to_string(dir.join("summary.md")).unwrap();
+    for needle in [
+        "joint 1500",
+        "Doppler-only 1500",
+        "Table 3",
+        "False alarms",
+        "Physical",
+    ] {
+        assert!(md.contains(needle), "{needle}: {md}");
+    }
+    for f in [
+        "curves.csv",
+        "table3.csv",
+        "fig7_pd.svg",
+        "fig8_ospa.svg",
+        "fig9_blades.svg",
+        "fig10_omega.svg",
+        "fig11_particles.svg",
+        "ablation_pd.svg",
+        "physical_pd.svg",
+        "false_alarms.svg",
+    ] {
+        assert!(dir.join(f).exists(), "{f}");
+    }
+    // --runs 1 was kept under --quick (whose default is 2).
+    let csv = std::fs::read_to_string(dir.join("curves.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let runs = header.iter().position(|h| *h == "runs").unwrap();
+    assert!(lines.all(|l| l.split(',').nth(runs) == Some("1")), "{csv}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn reproduce_cbmember_rejects_bad_arguments_before_any_run() {
+    for (args, needle) in [
+        (vec!["--runs", "0"], "--runs"),
+        (vec!["--snr-db", "nan"], "--snr-db"),
+        (vec!["--snr-db", "5:1:1"], "--snr-db"),
+        (vec!["--physical-snr-db", "0:10:0"], "--physical-snr-db"),
+        (vec!["--particles", "0"], "--particles"),
+        (vec!["--particles", "2000"], "--particles"),
+        (vec!["--timing-frames", "0"], "--timing-frames"),
+        (vec!["--sets", "fig12"], "--sets"),
+        (vec!["--quick", "--runs", "0"], "--runs"),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_faint"))
+            .args(["--quiet", "reproduce", "cbmember"])
+            .args(&args)
+            .output()
+            .expect("run faint");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} accepted");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: {stderr}");
+    }
+}

@@ -1,0 +1,6 @@
+//! CBMeMBer TBD with joint Doppler / micro-Doppler (rotor-UAV paper, 2023): the filter and
+//! its measurement model, and the reproduction's command line. One test binary for the
+//! family.
+
+mod cli;
+mod filter;
