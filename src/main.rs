@@ -85,7 +85,7 @@ struct DetectArgs {
 
 #[derive(clap::Args, Debug)]
 struct SimulateArgs {
-    /// Scenario preset: othr, sea-clutter or six-targets.
+    /// Scenario preset: othr, sea-clutter, six-targets or rotor-uav.
     scenario: String,
     /// Frames file to write (.npy for othr and six-targets, .csv for sea-clutter); the
     /// truth goes beside it as <stem>.truth.csv.
@@ -94,7 +94,8 @@ struct SimulateArgs {
     /// Seed.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// SNR in dB (othr: eq. 18 of Lu et al. 2017, default 8; six-targets: default 9).
+    /// SNR in dB (othr: eq. 18 of Lu et al. 2017, default 8; six-targets: default 9;
+    /// rotor-uav: default 10).
     #[arg(long, allow_hyphen_values = true)]
     snr_db: Option<f64>,
     /// Frames to write [default: one run of the preset].

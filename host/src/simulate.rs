@@ -6,11 +6,13 @@
 //! | `othr` | `(K, 32)` complex64 `.npy` | `frame,fd_hz` | one 32-bin Doppler frame (runs of 32 frames follow each other) |
 //! | `sea-clutter` | CSV `scan,amplitude,x,y` | `frame,x_m,y_m` | one scan (periods of 30 scans follow each other) |
 //! | `six-targets` | `(K, 142, 150, 90)` float32 `.npy` | `frame,x_m,y_m` | one power cube (at most the preset's 40) |
+//! | `rotor-uav` | `(K, 256, 512)` float32 `.npy` power maps | `frame,range_m,velocity_m_per_s` | one range-Doppler map (at most the preset's 40) |
 //!
 //! Run `r` of a multi-run file (`othr`, `sea-clutter`) draws from `Rng::from_stream(seed, r)`,
 //! the stream trial `r` of a reproduction with master seed `seed` gets; `six-targets`
 //! draws its truth from `Rng::from_stream(seed, 0).fork(1)` and its cubes from `.fork(2)`,
-//! as the reproduction's run 0 does.
+//! as the reproduction's run 0 does; `rotor-uav` its maps from
+//! `Rng::from_stream(seed, 0).fork(1)` (the reproduction's map stream of a run).
 
 use std::path::{Path, PathBuf};
 
@@ -20,6 +22,7 @@ use serde::Serialize;
 
 use crate::io::output::{write_complex_frames, write_plots, write_real_frames};
 use crate::io::write_csv;
+use crate::scenario::cbmember::{MapSource, RotorUav};
 use crate::scenario::crpf::{Noise, Othr};
 use crate::scenario::mht::SeaClutter;
 use crate::scenario::phd::SixTargets;
@@ -33,7 +36,8 @@ pub struct Spec {
     pub out: PathBuf,
     /// Seed.
     pub seed: u64,
-    /// SNR (dB; `othr`: eq. 18 of Lu et al. 2017, default 8; `six-targets`: default 9).
+    /// SNR (dB; `othr`: eq. 18 of Lu et al. 2017, default 8; `six-targets`: default 9;
+    /// `rotor-uav`: eq. 19 of the rotor-UAV paper, default 10).
     pub snr_db: Option<f64>,
     /// Frames (default: one run of the preset).
     pub frames: Option<usize>,
@@ -58,6 +62,13 @@ pub struct Simulated {
 struct Doppler {
     frame: usize,
     fd_hz: f64,
+}
+
+#[derive(Serialize)]
+struct RangeVelocity {
+    frame: usize,
+    range_m: f64,
+    velocity_m_per_s: f64,
 }
 
 #[derive(Serialize)]
@@ -106,6 +117,13 @@ pub fn check(spec: &Spec) -> Result<()> {
                 "--snr-db: sea-clutter has no SNR (use --lambda)"
             );
             extension_is(&spec.out, "csv", "sea-clutter")
+        }
+        "rotor-uav" => {
+            let max = RotorUav::new(10.0).frames;
+            if let Some(k) = spec.frames {
+                ensure!(k <= max, "--frames {k}: rotor-uav has {max} frames");
+            }
+            extension_is(&spec.out, "npy", "rotor-uav")
         }
         "six-targets" => {
             let max = SixTargets::new(9.0).frames;
@@ -184,6 +202,28 @@ pub fn simulate(spec: &Spec) -> Result<Simulated> {
                 r += 1;
             }
             write_plots(&spec.out, &scans)?;
+            write_csv(&truth_path, &truth)?;
+            k
+        }
+        "rotor-uav" => {
+            let sc = RotorUav::new(spec.snr_db.unwrap_or(10.0));
+            let k = spec.frames.unwrap_or(sc.frames);
+            let mut map_rng = Rng::from_stream(spec.seed, 0).fork(1);
+            let mut src = MapSource::new(&sc);
+            let g = sc.geometry();
+            let mut data = Vec::with_capacity(k * g.len());
+            let mut map = Vec::new();
+            let mut truth = Vec::new();
+            for (f, t) in sc.truth().iter().take(k).enumerate() {
+                src.power(&sc, t, f, &mut map_rng, &mut map);
+                data.extend_from_slice(&map);
+                truth.push(RangeVelocity {
+                    frame: f,
+                    range_m: t.range,
+                    velocity_m_per_s: t.velocity,
+                });
+            }
+            write_real_frames(&spec.out, &[k, g.n_range, g.n_velocity], &data)?;
             write_csv(&truth_path, &truth)?;
             k
         }

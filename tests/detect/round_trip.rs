@@ -309,3 +309,58 @@ fn truth_gives_gospa_and_plots() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn cbmember_detectors_round_trip() {
+    use faint::core::detect::cbmember::CbmemberConfig;
+    use faint::core::model::range_doppler::PointModel;
+    use faint::host::scenario::cbmember::{HostFilter as Cbm, MapSource, RotorUav};
+    let dir = temp("rt-cbm");
+    let file = dir.join("maps.npy");
+    let (code, _, err) = faint(&[
+        "simulate",
+        "rotor-uav",
+        "--out",
+        s(&file),
+        "--seed",
+        "11",
+        "--frames",
+        "6",
+        "--snr-db",
+        "12",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    // The reproduction's map stream of run 0.
+    let sc = RotorUav::new(12.0);
+    let mut map_rng = Rng::from_stream(SIM_SEED, 0).fork(1);
+    let mut src = MapSource::new(&sc);
+    let mut maps = Vec::new();
+    for (k, t) in sc.truth().iter().take(6).enumerate() {
+        let mut m = Vec::new();
+        src.power(&sc, t, k, &mut map_rng, &mut m);
+        maps.push(m);
+    }
+    for (name, model) in [
+        ("cbmember", PointModel::Joint),
+        ("cbmember-doppler", PointModel::DopplerOnly),
+    ] {
+        let cfg = CbmemberConfig {
+            model,
+            ..CbmemberConfig::rotor_uav()
+        };
+        let maps = maps.clone();
+        let want = std::thread::Builder::new()
+            .stack_size(256 << 20)
+            .spawn(move || {
+                let mut f = Box::new(Cbm::new(cfg, DET_SEED).unwrap());
+                rows_of(f.as_mut(), maps.iter().map(|m| m.as_slice()))
+            })
+            .unwrap()
+            .join()
+            .unwrap();
+        assert_eq!(detect(name, &file, &dir.join(name)), want, "{name}");
+    }
+    let truth = std::fs::read_to_string(dir.join("maps.truth.csv")).unwrap();
+    assert!(truth.starts_with("frame,range_m,velocity_m_per_s"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -20,6 +20,7 @@ use std::path::Path;
 
 use anyhow::{anyhow, bail, ensure, Context, Result};
 use faint_core::detect::bernoulli::BernoulliTbd;
+use faint_core::detect::cbmember::CbmemberConfig;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint_core::detect::mht::{ClassicHoughConfig, MhtConfig};
 use faint_core::detect::pf_lrt::PfLrt;
@@ -28,6 +29,7 @@ use faint_core::detect::phd::PhdConfig;
 use faint_core::detect::{run as run_frames, Detector, ScoreKind, Validate};
 use faint_core::model::doppler::estimate_noise_variance;
 use faint_core::model::plot::Plot;
+use faint_core::model::range_doppler::PointModel;
 use faint_core::Complex32;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
@@ -35,6 +37,7 @@ use serde::{Deserialize, Serialize};
 use crate::io::input::{read_complex_frames, read_plots, read_real_frames, Frames};
 use crate::montecarlo::progress_bar;
 use crate::reproduce::mht::{Classic, Mht};
+use crate::scenario::cbmember::HostFilter as CbmemberHost;
 use crate::scenario::mht::SeaClutter;
 use crate::scenario::phd::{HostFilter, SixTargets, Variant};
 use crate::timing::thread_cpu_seconds as cpu;
@@ -56,6 +59,8 @@ pub enum InputKind {
     Plots,
     /// `(K, R, D, A)` float32 `.npy`/`.npz`: one range x Doppler x azimuth power cube per frame.
     PowerCubes,
+    /// `(K, Nr, Nv)` float32 `.npy`/`.npz`: one range x velocity power map `|y|^2` per frame.
+    PowerMaps,
 }
 
 impl InputKind {
@@ -65,6 +70,7 @@ impl InputKind {
             InputKind::DopplerFrames => "(K, m) complex64 .npy/.npz or (K, m, 2) float32 I/Q",
             InputKind::Plots => "CSV scan,amplitude,x,y",
             InputKind::PowerCubes => "(K, R, D, A) float32 .npy/.npz power cubes",
+            InputKind::PowerMaps => "(K, Nr, Nv) float32 .npy/.npz range-Doppler power maps |y|^2",
         }
     }
 }
@@ -238,7 +244,69 @@ pub const REGISTRY: &[Entry] = &[
         default_config: || default_phd(Variant::PsoDbscan),
         run: |r| run_phd(r, "pso-phd-dbscan", Variant::PsoDbscan),
     },
+    Entry {
+        name: "cbmember",
+        about: "CBMeMBer TBD, joint Doppler / micro-Doppler (rotor-UAV paper, 2023)",
+        input: InputKind::PowerMaps,
+        default_config: || default_cbmember(PointModel::Joint),
+        run: |r| run_cbmember(r, "cbmember", PointModel::Joint),
+    },
+    Entry {
+        name: "cbmember-doppler",
+        about: "CBMeMBer TBD, Doppler only (the baseline of the rotor-UAV paper, 2023)",
+        input: InputKind::PowerMaps,
+        default_config: || default_cbmember(PointModel::DopplerOnly),
+        run: |r| run_cbmember(r, "cbmember-doppler", PointModel::DopplerOnly),
+    },
 ];
+
+fn default_cbmember(model: PointModel) -> String {
+    json(&Plain {
+        config: CbmemberConfig {
+            model,
+            ..CbmemberConfig::rotor_uav()
+        },
+    })
+}
+
+fn run_cbmember(req: &Request, name: &'static str, model: PointModel) -> Result<Outcome> {
+    let t = cpu();
+    let default = match model {
+        PointModel::Joint => find_default("cbmember"),
+        PointModel::DopplerOnly => find_default("cbmember-doppler"),
+    };
+    let file: Plain<CbmemberConfig> =
+        load(req, default, |f: &Plain<CbmemberConfig>| valid(&f.config))?;
+    let maps = read_real_frames(req.input, 3)?;
+    let g = file.config.geometry;
+    let want = [g.n_range, g.n_velocity];
+    ensure!(
+        maps.shape[1..] == want,
+        "{}: maps of shape {:?}, the config's geometry is (n_range, n_velocity) = {:?}",
+        req.input.display(),
+        &maps.shape[1..],
+        want
+    );
+    let read = cpu() - t;
+    let cfg = file.config;
+    let mut det = std::thread::Builder::new()
+        .stack_size(256 << 20)
+        .spawn(move || CbmemberHost::new(cfg, 0).map(Box::new))
+        .context("cannot start the filter thread")?
+        .join()
+        .map_err(|_| anyhow!("the filter thread panicked"))?
+        .map_err(|e| anyhow!("{e}"))?;
+    det.configure(&cfg, req.seed).map_err(|e| anyhow!("{e}"))?;
+    let mut out = drive(
+        name,
+        det.as_mut(),
+        (0..maps.frames()).map(|k| maps.frame(k)),
+        req,
+        &[0, 1],
+    )?;
+    out.read_seconds = read;
+    Ok(out)
+}
 
 /// The entry called `name`; an unknown name lists the known ones.
 pub fn find(name: &str) -> Result<&'static Entry> {

@@ -337,6 +337,7 @@ impl Validate for CbmemberConfig {
 
 /// Per-frame summary.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct CbmemberReport {
     /// Live components after the step.
     pub components: usize,
