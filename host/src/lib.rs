@@ -13,6 +13,8 @@
 //! - [`detect`]: every detector on a user's files, behind `faint detect <name>`.
 //! - [`simulate`]: a preset's frames and truth as files, behind `faint simulate <scenario>`.
 
+#![warn(missing_docs)]
+
 pub mod analysis;
 pub mod detect;
 pub mod io;
