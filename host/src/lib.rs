@@ -14,6 +14,8 @@
 //! - [`timing`]: this thread's CPU time, for measurements on a shared machine.
 //! - [`simulate`]: a preset's frames and truth as files, behind `faint simulate <scenario>`.
 
+#![warn(missing_docs)]
+
 pub mod analysis;
 pub mod detect;
 pub mod io;

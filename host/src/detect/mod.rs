@@ -11,7 +11,7 @@
 //! [`PARTICLES`]) and `"estimate_noise"` for the Gaussian comparators. Unknown keys are
 //! rejected; values are checked by the core's own `validate`.
 //!
-//! Outputs ([`write`]): `detections.csv` / `detections.json` (frame, detector, score,
+//! Outputs ([`write()`]): `detections.csv` / `detections.json` (frame, detector, score,
 //! track id and length, state), `summary.csv` (per frame: detections and best score),
 //! `reports.json` (the core's per-frame reports), `score.svg` and `tracks.svg`, and with a
 //! truth file `gospa.csv` (per-frame GOSPA, alpha = 2, with its decomposition).

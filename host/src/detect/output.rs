@@ -71,7 +71,7 @@ pub fn read_truth(path: &Path, names: &[&str], frames: usize) -> Result<Vec<Vec<
     Ok(out)
 }
 
-/// Files written by [`write`] and the run's totals.
+/// Files written by [`write()`] and the run's totals.
 #[derive(Debug, Clone, Serialize)]
 pub struct Written {
     /// The output folder.

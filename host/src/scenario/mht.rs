@@ -1,4 +1,4 @@
-//! Scenario preset `sea-clutter` (paper 003, §5.1): plot lists out of a low-threshold
+//! Scenario preset `sea-clutter` (Bao et al. 2022, §5.1): plot lists out of a low-threshold
 //! pre-detector over a 6 km x 6 km sea area, Poisson clutter plots of mean `lambda` per scan
 //! uniform over the area, 5 constant-velocity targets with random start, heading and
 //! speed `U(0, V_max)`, detection probability `Pd0`, 5 m rms position noise.

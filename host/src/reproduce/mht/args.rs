@@ -1,0 +1,173 @@
+//! Command line of `faint reproduce mht`: the clap [`Args`], its value enums
+//! ([`ModelChoice`], [`GammaFrom`], [`CalibRule`]), the checks run before any trial and
+//! the run sizes with the `--quick` preset applied.
+
+use std::path::PathBuf;
+
+#[cfg(doc)]
+use super::calibration::calibrate;
+use super::calibration::proportion_ci;
+
+/// Command-line arguments.
+#[derive(clap::Args, Debug, Clone)]
+pub struct Args {
+    /// Clutter plots per scan (repeatable).
+    #[arg(long = "lambda", num_args = 1.., default_values_t = vec![80.0, 164.0, 237.0, 316.0, 398.0])]
+    pub lambda: Vec<f32>,
+    /// Trials per lambda (with targets).
+    #[arg(long, default_value_t = 2000)]
+    pub trials: usize,
+    /// Clutter-only trials per lambda for the model-threshold check.
+    #[arg(long, default_value_t = 500)]
+    pub null_trials: usize,
+    /// Wanted whole-grid Pfa for the thresholds.
+    #[arg(long, default_value_t = 1e-4)]
+    pub pfa: f64,
+    /// Master seed.
+    #[arg(long, default_value_t = 2022)]
+    pub seed: u64,
+    /// Output folder.
+    #[arg(long, default_value = "out/mht")]
+    pub out: PathBuf,
+    /// Use this `gamma_1` for every lambda instead of the model's (e.g. the paper's 22).
+    #[arg(long)]
+    pub gamma1: Option<u8>,
+    /// CI size: 20 trials, 20 null trials.
+    #[arg(long)]
+    pub quick: bool,
+    /// Per-cell clutter law that sets `gamma_1`: `paper` (eq. 20-26 as published) or
+    /// `compound` (chain-stacking law, the default: holds the wanted Pfa in simulation);
+    /// `compound-nc` is the compound law with the paper's `N_c` chains (for comparison).
+    #[arg(long, value_enum, default_value_t = ModelChoice::Compound)]
+    pub model: ModelChoice,
+    /// Where `gamma_1` comes from: `model` (the `--model` law's grid Pfa) or `sim`
+    /// (clutter-only simulation: the smallest `gamma_1` whose rate of periods with a
+    /// confirmed track meets `--pfa` by `--calib-rule`, see [`calibrate`]).
+    #[arg(long, value_enum, default_value_t = GammaFrom::Model)]
+    pub gamma_from: GammaFrom,
+    /// Clutter-only periods per lambda for `--gamma-from sim`.
+    #[arg(long, default_value_t = 20_000)]
+    pub calib_periods: usize,
+    /// Independent clutter-only periods per lambda that check the calibrated `gamma_1`
+    /// (0: no check).
+    #[arg(long, default_value_t = 10_000)]
+    pub calib_check: usize,
+    /// Calibration rule: `point` (estimated rate `k / T <= pfa`) or `upper` (the
+    /// Clopper-Pearson 95 % interval's upper end `<= pfa`; needs `T >~ 3.7 / pfa`).
+    #[arg(long, value_enum, default_value_t = CalibRule::Point)]
+    pub calib_rule: CalibRule,
+    /// Smallest candidate `gamma_1` of the calibration (candidates below it are not
+    /// simulated; a result at this floor is flagged).
+    #[arg(long, default_value_t = 3)]
+    pub calib_min_gamma: u8,
+}
+
+/// `--gamma-from` values.
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub enum GammaFrom {
+    /// The `--model` law.
+    #[default]
+    Model,
+    /// Clutter-only simulation of the confirmed-false-track rate ([`calibrate`]).
+    Sim,
+}
+
+/// `--calib-rule` values: how a candidate `gamma_1` passes with `k` of `T` clutter-only
+/// periods giving a confirmed track.
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub enum CalibRule {
+    /// `k / T <= pfa`.
+    #[default]
+    Point,
+    /// Clopper-Pearson 95 % upper end `<= pfa` (one-sided 97.5 %).
+    Upper,
+}
+
+impl CalibRule {
+    /// Does `k` of `n` periods with a confirmed track pass at the wanted `pfa`?
+    pub fn passes(self, k: u64, n: u64, pfa: f64) -> bool {
+        match self {
+            Self::Point => (k as f64) <= pfa * n as f64,
+            Self::Upper => proportion_ci(k, n).2 <= pfa,
+        }
+    }
+}
+
+/// `--model` values.
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub enum ModelChoice {
+    /// Eq. 20-26 as published.
+    Paper,
+    /// Compound law, chains from the censoring rule (default).
+    #[default]
+    Compound,
+    /// Compound law with the paper's `N_c` clutter tracks.
+    CompoundNc,
+}
+
+/// Run sizes after the `--quick` preset.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Sizes {
+    /// Trials per lambda (with targets).
+    pub(super) trials: usize,
+    /// Clutter-only trials per lambda.
+    pub(super) null_trials: usize,
+    /// Clutter-only calibration periods per lambda (`--gamma-from sim`).
+    pub(super) calib_periods: usize,
+    /// Independent clutter-only check periods per lambda (`--gamma-from sim`).
+    pub(super) calib_check: usize,
+}
+
+impl Args {
+    /// Checks the arguments before any work is done (and warns when `--calib-rule upper`
+    /// cannot reach `--pfa` with the calibration periods); returns the run sizes.
+    pub(super) fn validate(&self) -> anyhow::Result<Sizes> {
+        let args = self;
+        anyhow::ensure!(
+            args.pfa > 0.0 && args.pfa < 1.0,
+            "--pfa must lie in (0, 1), got {}",
+            args.pfa
+        );
+        anyhow::ensure!(args.trials > 0, "--trials must be at least 1");
+        anyhow::ensure!(!args.lambda.is_empty(), "give at least one --lambda");
+        for &l in &args.lambda {
+            anyhow::ensure!(
+                l.is_finite() && l > 0.0 && l <= 2000.0,
+                "--lambda must lie in (0, 2000] clutter plots per scan, got {l}"
+            );
+        }
+        if let Some(g) = args.gamma1 {
+            anyhow::ensure!(g >= 1, "--gamma1 must be at least 1");
+        }
+        anyhow::ensure!(
+            !(args.gamma1.is_some() && args.gamma_from == GammaFrom::Sim),
+            "--gamma1 and --gamma-from sim exclude each other"
+        );
+        let sizes = if args.quick {
+            Sizes {
+                trials: 20,
+                null_trials: 20,
+                calib_periods: 200,
+                calib_check: 200,
+            }
+        } else {
+            Sizes {
+                trials: args.trials,
+                null_trials: args.null_trials,
+                calib_periods: args.calib_periods,
+                calib_check: args.calib_check,
+            }
+        };
+        let calib_periods = sizes.calib_periods;
+        if args.gamma_from == GammaFrom::Sim {
+            anyhow::ensure!(calib_periods > 0, "--calib-periods must be at least 1");
+            if args.calib_rule == CalibRule::Upper && (calib_periods as f64) * args.pfa < 3.7 {
+                eprintln!(
+                    "warning: --calib-rule upper with {calib_periods} periods cannot reach pfa {} (zero events give an upper bound ~3.7 / T): gamma_1 will be N + 1",
+                    args.pfa
+                );
+            }
+        }
+        Ok(sizes)
+    }
+}

@@ -1,0 +1,467 @@
+//! Monte Carlo evaluation of `faint reproduce mht`: the detectors' capacities and types
+//! ([`Mht`], [`Classic`]), one trial of both detectors scored by the rules of the module
+//! doc ([`evaluate_trial`]), the scoring and clutter-only trials of one lambda, and their
+//! per-lambda summary against the models.
+
+use faint_core::detect::mht::{
+    ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, NO_PLOT,
+};
+use faint_core::detect::Detector;
+
+use super::args::{Args, Sizes};
+use super::calibration::{model_params, proportion_ci, Gammas, GridModel};
+use crate::analysis::mht::{self as model, CellModel, ChainSource, CompoundModel};
+use crate::scenario::mht::{Origin, SeaClutter, Trial};
+
+/// Plots per scan capacity (Poisson(398) exceeds 520 with probability ~1e-9).
+pub const P: usize = 640;
+/// Scans per period capacity.
+pub const NS: usize = 30;
+/// `N_rho`.
+pub const NR: usize = 256;
+/// `N_theta`.
+pub const NT: usize = 180;
+/// Track capacity.
+pub const TR: usize = 32;
+/// The MHT-TBD detector of the reproduction.
+pub type Mht = MhtTbd<P, NS, NR, NT, TR>;
+/// The classic detector of the reproduction.
+pub type Classic = ClassicHough<NR, NT, 64>;
+/// Line-to-truth tolerance (m).
+pub const MATCH_TOL: f32 = 60.0;
+
+/// Re-exported for tests: the geometry type of the reproduction.
+pub type Grid = Geometry<NR, NT>;
+
+/// Everything measured in one trial.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+pub struct TrialStats {
+    /// Clutter plots over the period.
+    pub pre_clutter: u32,
+    /// Clutter plots marked effective.
+    pub eff_clutter: u32,
+    /// Target plots over the period.
+    pub target_plots: u32,
+    /// Target plots marked effective.
+    pub eff_target: u32,
+    /// MHT: targets detected.
+    pub mht_detected: u32,
+    /// MHT: false tracks.
+    pub mht_false: u32,
+    /// MHT: duplicate tracks.
+    pub mht_dup: u32,
+    /// MHT: target plots of detected targets.
+    pub mht_target_plots: u32,
+    /// MHT: of those, not in the track.
+    pub mht_lost: u32,
+    /// MHT: plots in the matched tracks.
+    pub mht_track_plots: u32,
+    /// MHT: of those, not the target's.
+    pub mht_wrong: u32,
+    /// MHT: of the matched tracks' plots, taken by look-back.
+    pub mht_lookback: u32,
+    /// Classic: targets detected.
+    pub classic_detected: u32,
+    /// Classic: false peaks.
+    pub classic_false: u32,
+    /// Largest DMHT cell count of the period.
+    pub mht_max_count: u8,
+    /// Largest classic cell count of the period.
+    pub classic_max_count: u8,
+}
+
+fn line_matches(theta: f32, c: f32, trial: &Trial, i: usize, t_scan: f32) -> bool {
+    let (co, si) = (theta.cos(), theta.sin());
+    let t = &trial.targets[i];
+    (0..trial.scans.len()).all(|s| {
+        let (x, y) = t.position(s as f32 * t_scan);
+        (x * co + y * si - c).abs() <= MATCH_TOL
+    })
+}
+
+pub(super) fn max_count<const R: usize, const A: usize>(
+    acc: &faint_core::detect::mht::Accumulator<R, A>,
+) -> u8 {
+    let mut m = 0;
+    for a in 0..A {
+        for r in 0..R {
+            m = m.max(acc.count(r, a));
+        }
+    }
+    m
+}
+
+/// Run both detectors on one trial and score them.
+pub fn evaluate_trial(
+    sc: &SeaClutter,
+    trial: &Trial,
+    mht: &mut Mht,
+    classic: &mut Classic,
+) -> TrialStats {
+    let mut st = TrialStats::default();
+    let nt = trial.targets.len();
+    for scan in &trial.scans {
+        let _ = mht.step(&scan.plots);
+        let _ = classic.step(&scan.plots);
+    }
+    // censoring statistics (plots are stored in input order: all are in-area)
+    for (s, scan) in trial.scans.iter().enumerate() {
+        for (k, o) in scan.origin.iter().enumerate() {
+            let eff = mht.is_effective(s, k);
+            match o {
+                Origin::Clutter => {
+                    st.pre_clutter += 1;
+                    st.eff_clutter += u32::from(eff);
+                }
+                Origin::Target(_) => {
+                    st.target_plots += 1;
+                    st.eff_target += u32::from(eff);
+                }
+            }
+        }
+    }
+    st.mht_max_count = max_count(mht.accumulator());
+    st.classic_max_count = max_count(classic.accumulator());
+    // MHT tracks
+    let tracks = mht.tracks();
+    let mut matched = vec![false; nt];
+    for tr in tracks {
+        let n_of = |i: usize| {
+            (0..trial.scans.len())
+                .filter(|&s| {
+                    tr.plots[s] != NO_PLOT
+                        && trial.scans[s].origin[usize::from(tr.plots[s])] == Origin::Target(i)
+                })
+                .count()
+        };
+        let hits: Vec<usize> = (0..nt)
+            .filter(|&i| {
+                line_matches(tr.theta, tr.c, trial, i, sc.t_scan)
+                    || 2 * n_of(i) > usize::from(tr.n_plots)
+            })
+            .collect();
+        if hits.is_empty() {
+            st.mht_false += 1;
+        } else if hits.iter().all(|&i| matched[i]) {
+            st.mht_dup += 1;
+        }
+        for i in hits {
+            matched[i] = true;
+        }
+    }
+    for (i, m) in matched.iter().enumerate() {
+        if !*m {
+            continue;
+        }
+        st.mht_detected += 1;
+        let own = |s: usize, k: u16| {
+            k != NO_PLOT && trial.scans[s].origin[usize::from(k)] == Origin::Target(i)
+        };
+        let best = tracks.iter().max_by_key(|tr| {
+            (0..trial.scans.len())
+                .filter(|&s| own(s, tr.plots[s]))
+                .count()
+        });
+        let n_own: u32 = trial
+            .scans
+            .iter()
+            .map(|sd| {
+                sd.origin
+                    .iter()
+                    .filter(|&&o| o == Origin::Target(i))
+                    .count() as u32
+            })
+            .sum();
+        st.mht_target_plots += n_own;
+        if let Some(tr) = best {
+            let got = (0..trial.scans.len())
+                .filter(|&s| own(s, tr.plots[s]))
+                .count() as u32;
+            st.mht_lost += n_own - got.min(n_own);
+            st.mht_track_plots += u32::from(tr.n_plots);
+            st.mht_wrong += u32::from(tr.n_plots) - got;
+            st.mht_lookback += tr.lookback.count_ones();
+        } else {
+            st.mht_lost += n_own;
+        }
+    }
+    // classic peaks
+    let g = classic.geometry();
+    let (x0, y0) = g.origin();
+    let mut cmatched = vec![false; nt];
+    for pk in classic.peaks() {
+        let a = usize::from(pk.a);
+        let (co, si) = g.trig(a);
+        let c = x0 * co + y0 * si + g.rho_center(usize::from(pk.r));
+        let hits: Vec<usize> = (0..nt)
+            .filter(|&i| line_matches(g.theta(a), c, trial, i, sc.t_scan))
+            .collect();
+        if hits.is_empty() {
+            st.classic_false += 1;
+        }
+        for i in hits {
+            cmatched[i] = true;
+        }
+    }
+    st.classic_detected = cmatched.iter().filter(|&&m| m).count() as u32;
+    st
+}
+
+/// Build the two detectors for a lambda and its thresholds.
+pub fn detectors(
+    sc: &SeaClutter,
+    gamma1: u8,
+    gamma_classic: u8,
+) -> anyhow::Result<(Box<Mht>, Box<Classic>)> {
+    let mut cfg = MhtConfig::sea_clutter();
+    cfg.area = sc.area;
+    cfg.n_scans = sc.n_scans;
+    cfg.gate = sc.v_max * sc.t_scan;
+    cfg.along_gate = cfg.gate;
+    cfg.gamma1 = gamma1;
+    let mht = Box::new(Mht::new(cfg).map_err(|e| anyhow::anyhow!("{e}"))?);
+    let ccfg = ClassicHoughConfig {
+        area: sc.area,
+        n_scans: sc.n_scans,
+        gamma: gamma_classic,
+    };
+    let classic = Box::new(Classic::new(ccfg).map_err(|e| anyhow::anyhow!("{e}"))?);
+    Ok((mht, classic))
+}
+
+/// The scoring trials (`sizes.trials`, targets on) and the clutter-only trials
+/// (`sizes.null_trials`) of lambda number `li` at the thresholds `th`.
+pub(super) fn trials(
+    args: &Args,
+    sizes: &Sizes,
+    li: usize,
+    sc: &SeaClutter,
+    th: &Gammas,
+) -> anyhow::Result<(Vec<TrialStats>, Vec<TrialStats>)> {
+    let Sizes {
+        trials,
+        null_trials,
+        ..
+    } = *sizes;
+    let lambda = sc.lambda;
+    let (sc, g1, gc) = (*sc, th.gamma1, th.gamma_classic);
+    let g1u = g1.clamp(1, 255) as u8;
+    let gcu = gc.clamp(1, 255) as u8;
+    // Surface a configuration error once, before the trials (which cannot report it).
+    detectors(&sc, g1u, gcu).map_err(|e| anyhow::anyhow!("lambda {lambda}: {e}"))?;
+    let seed = faint_core::rng::derive_seed(args.seed, li as u64);
+    let res: Vec<TrialStats> =
+        crate::montecarlo::run_trials(seed, trials, &format!("mht lambda={lambda}"), |_, rng| {
+            let Ok((mut m, mut c)) = detectors(&sc, g1u, gcu) else {
+                return TrialStats::default();
+            };
+            let tr = sc.generate(rng);
+            evaluate_trial(&sc, &tr, &mut m, &mut c)
+        });
+    let mut null_sc = sc;
+    null_sc.n_targets = 0;
+    let nres: Vec<TrialStats> = crate::montecarlo::run_trials(
+        seed ^ 0x6e75_6c6c,
+        null_trials,
+        &format!("null lambda={lambda}"),
+        |_, rng| {
+            let Ok((mut m, mut c)) = detectors(&null_sc, g1u, gcu) else {
+                return TrialStats::default();
+            };
+            let tr = null_sc.generate(rng);
+            evaluate_trial(&null_sc, &tr, &mut m, &mut c)
+        },
+    );
+    Ok((res, nres))
+}
+
+/// Per-lambda summary row.
+#[derive(Debug, serde::Serialize)]
+pub(super) struct Summary {
+    pub(super) lambda: f32,
+    pub(super) trials: usize,
+    pub(super) null_trials: usize,
+    pub(super) gamma1: usize,
+    pub(super) gamma_classic: usize,
+    pub(super) clutter_per_scan_before: f64,
+    pub(super) clutter_per_scan_after: f64,
+    pub(super) clutter_after_model: f64,
+    pub(super) clutter_after_compound: f64,
+    pub(super) target_plots_kept: f64,
+    pub(super) mht_pd: f64,
+    pub(super) mht_pd_lo: f64,
+    pub(super) mht_pd_hi: f64,
+    pub(super) mht_false_tracks: u64,
+    pub(super) mht_trials_with_fa: u64,
+    pub(super) mht_dup: u64,
+    pub(super) plot_loss: f64,
+    pub(super) wrong_plot: f64,
+    pub(super) lookback_share: f64,
+    pub(super) classic_pd: f64,
+    pub(super) classic_false_peaks: u64,
+    pub(super) classic_trials_with_fa: u64,
+    pub(super) null_pfa_sim: f64,
+    pub(super) null_pfa_lo: f64,
+    pub(super) null_pfa_hi: f64,
+    pub(super) null_pfa_model: f64,
+    pub(super) null_confirmed_fa_trials: u64,
+    pub(super) classic_null_pfa_sim: f64,
+    pub(super) gamma1_model: usize,
+    pub(super) calib_periods: u64,
+    pub(super) calib_periods_with_track: u64,
+    pub(super) calib_rate: f64,
+    pub(super) calib_rate_hi: f64,
+    pub(super) calib_at_floor: bool,
+    pub(super) check_periods: u64,
+    pub(super) check_periods_with_track: u64,
+    pub(super) check_tracks: u64,
+    pub(super) check_rate: f64,
+    pub(super) check_rate_lo: f64,
+    pub(super) check_rate_hi: f64,
+}
+
+/// Clutter-only Pfa row.
+#[derive(Debug, serde::Serialize)]
+pub(super) struct NullRow {
+    pub(super) lambda: f32,
+    pub(super) gamma: usize,
+    pub(super) sim_pfa: f64,
+    pub(super) model_pfa: f64,
+    pub(super) classic_sim_pfa: f64,
+}
+
+/// The summary of one lambda from its scoring trials `res` and clutter-only trials
+/// `nres`; appends the clutter-only grid Pfa per `gamma` to `null_rows`.
+pub(super) fn summarise(
+    args: &Args,
+    sizes: &Sizes,
+    sc: &SeaClutter,
+    th: &Gammas,
+    res: &[TrialStats],
+    nres: &[TrialStats],
+    null_rows: &mut Vec<NullRow>,
+) -> Summary {
+    let Sizes {
+        trials,
+        null_trials,
+        ..
+    } = *sizes;
+    let Gammas {
+        gamma1: g1,
+        gamma1_model: g1_model,
+        gamma_classic: gc,
+        ref calib,
+        ref check,
+    } = *th;
+    let lambda = sc.lambda;
+    let sc = *sc;
+    let mut null_sc = sc;
+    null_sc.n_targets = 0;
+    let sum = |f: &dyn Fn(&TrialStats) -> u32| res.iter().map(|t| u64::from(f(t))).sum::<u64>();
+    let n_scans = (sc.n_scans * trials) as f64;
+    let det = sum(&|t| t.mht_detected);
+    let (pd, lo, hi) = proportion_ci(det, (trials * sc.n_targets) as u64);
+    let cdet = sum(&|t| t.classic_detected);
+    let cm = CellModel::new(model_params(&sc));
+    // the clutter-only periods are compared with the chosen model for N_t = 0
+    let null_model = GridModel::new(model_params(&null_sc), args.model);
+    let m0 = cm
+        .p0_raw
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(k, p)| k as f64 * p)
+        .sum::<f64>();
+    // expected effective clutter plots per scan: N_rho N_theta E[m] / N per cell-track
+    // would count a plot once per cell it shares; the model's number of clutter
+    // tracks times their mean length, per scan:
+    let after_model = cm.n_c * (m0 / model::tail(&cm.p0_raw, 1).max(1e-300)) / sc.n_scans as f64;
+    let nhit = nres
+        .iter()
+        .filter(|t| usize::from(t.mht_max_count) >= g1)
+        .count() as u64;
+    let (np, nlo, nhi) = proportion_ci(nhit, null_trials as u64);
+    let chit = nres
+        .iter()
+        .filter(|t| usize::from(t.classic_max_count) >= gc)
+        .count() as f64;
+    for g in 1..=sc.n_scans {
+        let k = nres
+            .iter()
+            .filter(|t| usize::from(t.mht_max_count) >= g)
+            .count() as u64;
+        let kc = nres
+            .iter()
+            .filter(|t| usize::from(t.classic_max_count) >= g)
+            .count() as u64;
+        null_rows.push(NullRow {
+            lambda,
+            gamma: g,
+            sim_pfa: k as f64 / null_trials.max(1) as f64,
+            model_pfa: null_model.pfa_grid(g),
+            classic_sim_pfa: kc as f64 / null_trials.max(1) as f64,
+        });
+    }
+    Summary {
+        lambda,
+        trials,
+        null_trials,
+        gamma1: g1,
+        gamma_classic: gc,
+        clutter_per_scan_before: sum(&|t| t.pre_clutter) as f64 / n_scans,
+        clutter_per_scan_after: sum(&|t| t.eff_clutter) as f64 / n_scans,
+        clutter_after_model: after_model,
+        clutter_after_compound: CompoundModel::new(model_params(&null_sc), ChainSource::Censoring)
+            .clutter_per_scan(),
+        target_plots_kept: sum(&|t| t.eff_target) as f64 / sum(&|t| t.target_plots).max(1) as f64,
+        mht_pd: pd,
+        mht_pd_lo: lo,
+        mht_pd_hi: hi,
+        mht_false_tracks: sum(&|t| t.mht_false),
+        mht_trials_with_fa: res.iter().filter(|t| t.mht_false > 0).count() as u64,
+        mht_dup: sum(&|t| t.mht_dup),
+        plot_loss: sum(&|t| t.mht_lost) as f64 / sum(&|t| t.mht_target_plots).max(1) as f64,
+        wrong_plot: sum(&|t| t.mht_wrong) as f64 / sum(&|t| t.mht_track_plots).max(1) as f64,
+        lookback_share: sum(&|t| t.mht_lookback) as f64 / sum(&|t| t.mht_track_plots).max(1) as f64,
+        classic_pd: cdet as f64 / (trials * sc.n_targets).max(1) as f64,
+        classic_false_peaks: sum(&|t| t.classic_false),
+        classic_trials_with_fa: res.iter().filter(|t| t.classic_false > 0).count() as u64,
+        null_pfa_sim: np,
+        null_pfa_lo: nlo,
+        null_pfa_hi: nhi,
+        null_pfa_model: null_model.pfa_grid(g1),
+        null_confirmed_fa_trials: nres.iter().filter(|t| t.mht_false > 0).count() as u64,
+        classic_null_pfa_sim: chit / null_trials.max(1) as f64,
+        gamma1_model: g1_model,
+        calib_periods: calib.as_ref().map_or(0, |c| c.0.periods),
+        calib_periods_with_track: calib
+            .as_ref()
+            .and_then(|c| c.0.with_track.get(g1).copied())
+            .unwrap_or(0),
+        calib_rate: calib.as_ref().map_or(f64::NAN, |c| {
+            proportion_ci(c.0.with_track.get(g1).copied().unwrap_or(0), c.0.periods).0
+        }),
+        calib_rate_hi: calib.as_ref().map_or(f64::NAN, |c| {
+            proportion_ci(c.0.with_track.get(g1).copied().unwrap_or(0), c.0.periods).2
+        }),
+        calib_at_floor: calib.as_ref().is_some_and(|c| c.1),
+        check_periods: check.as_ref().map_or(0, |c| c.periods),
+        check_periods_with_track: check
+            .as_ref()
+            .and_then(|c| c.with_track.get(g1).copied())
+            .unwrap_or(0),
+        check_tracks: check
+            .as_ref()
+            .and_then(|c| c.tracks.get(g1).copied())
+            .unwrap_or(0),
+        check_rate: check.as_ref().map_or(f64::NAN, |c| {
+            proportion_ci(c.with_track.get(g1).copied().unwrap_or(0), c.periods).0
+        }),
+        check_rate_lo: check.as_ref().map_or(f64::NAN, |c| {
+            proportion_ci(c.with_track.get(g1).copied().unwrap_or(0), c.periods).1
+        }),
+        check_rate_hi: check.as_ref().map_or(f64::NAN, |c| {
+            proportion_ci(c.with_track.get(g1).copied().unwrap_or(0), c.periods).2
+        }),
+    }
+}
