@@ -590,14 +590,25 @@ impl<'a> BlockMap<'a> {
                 requested: need,
             });
         };
-        map.check()?;
+        // One pass: the sums, and a flag for any pixel that is not a finite power >= 0
+        // (NaN fails `z >= 0`, +inf makes a sum infinite); the rare bad map is then
+        // classified by `check`.
+        let mut ok = true;
         for (i, row) in out.chunks_exact_mut(nb.max(1)).enumerate() {
-            row.iter_mut().for_each(|x| *x = 0.0);
-            map.for_each(dq, i * g.n_velocity, g.n_velocity, |j, z| {
-                if let Some(x) = row.get_mut(j / block) {
-                    *x += z;
-                }
-            });
+            for (m, x) in row.iter_mut().enumerate() {
+                let mut acc = 0.0f32;
+                let mut good = true;
+                map.for_each(dq, i * g.n_velocity + m * block, block, |_, z| {
+                    acc += z;
+                    good &= z >= 0.0;
+                });
+                ok &= good && acc.is_finite();
+                *x = acc;
+            }
+        }
+        if !ok {
+            map.check()?;
+            return Err(Error::NonFinite);
         }
         Ok(Self {
             sums: &*out,

@@ -986,9 +986,9 @@ fn summary(rows: &[Row], timing: &[TimingRow]) -> String {
     let runs = n("base");
     let at = |set: &str, name: &str, lvl: f64| snr_at_pd(&curve(rows, set, name), lvl);
     if rows.iter().any(|r| r.set == "base") {
-        s.push_str(&format!(
-            "### Sensitivity (Fig. 7, 11), {runs} runs per SNR point\n\n"
-        ));
+        s.push_str(
+            "### Sensitivity: SNR at Pd 0.9 (Fig. 7, 9, 10, 11, ablations; runs per point in the table)\n\n",
+        );
         let mut t = Vec::new();
         let dop = at("base", "Doppler-only 1500", 0.9);
         let names: Vec<String> = rows
@@ -998,6 +998,8 @@ fn summary(rows: &[Row], timing: &[TimingRow]) -> String {
                     || r.set.starts_with("blades")
                     || r.set.starts_with("omega")
                     || r.set == "ablation"
+                    || r.set == "merge"
+                    || r.set == "known"
             })
             .map(|r| format!("{}|{}", r.set, r.curve))
             .fold(Vec::new(), |mut v, n| {
@@ -1056,10 +1058,9 @@ fn summary(rows: &[Row], timing: &[TimingRow]) -> String {
             .map(|r| r.snr_db)
             .fold(f64::NEG_INFINITY, f64::max);
         let mut t = Vec::new();
-        for r in rows
-            .iter()
-            .filter(|r| (r.set == "base" || r.set == "merge") && r.snr_db == top)
-        {
+        for r in rows.iter().filter(|r| {
+            (r.set == "base" || r.set == "merge" || r.set == "known") && r.snr_db == top
+        }) {
             t.push(vec![
                 format!("{} ({})", r.curve, r.set),
                 format!("{}", r.snr_db),
@@ -1117,7 +1118,8 @@ fn summary(rows: &[Row], timing: &[TimingRow]) -> String {
     let ph: Vec<&Row> = rows.iter().filter(|r| r.set == "physical").collect();
     if !ph.is_empty() {
         s.push_str(&format!(
-            "\n### Physical generator (eq. 11 + slow-time FFT), {runs} runs\n\n"
+            "\n### Physical generator (eq. 11 + slow-time FFT), {} runs per point\n\n",
+            n("physical")
         ));
         let t: Vec<Vec<String>> = ph
             .iter()
