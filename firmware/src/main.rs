@@ -14,6 +14,7 @@ use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
 
 mod crpf;
+mod dp;
 mod harness;
 mod mht;
 mod phd;
@@ -32,6 +33,7 @@ fn main() -> ! {
     mht::run();
     crpf::run();
     phd::run();
+    dp::run();
     hprintln!();
     hprintln!(
         "static RAM of this image (.data + .bss, all rows): {} bytes",

@@ -33,6 +33,7 @@
 use core::fmt;
 
 pub mod crpf;
+pub mod dp;
 pub mod phd;
 
 use faint_core::existence::ExistenceMarkov;
@@ -103,6 +104,7 @@ pub fn cases(emit: &mut dyn FnMut(&str, &[u32])) {
     mht::cases(emit);
     crpf::cases(emit);
     phd::cases(emit);
+    dp::cases(emit);
 }
 
 fn bits<const K: usize>(mut f: impl FnMut() -> f32) -> [u32; K] {

@@ -6,8 +6,10 @@
 //! | [`pf_tbd`], [`bernoulli`], [`pf_lrt`] | PF-TBD, JOTT, PF-LRT (its comparators) | `[Complex32]` |
 //! | [`hough`] | MHT-TBD (Bao et al. 2022), classic Hough TBD | `[Plot]`, one scan |
 //! | [`phd`] | SMC-PHD TBD with the PSO step (Pei et al. 2019) | `[f32]`, one power cube |
+//! | [`dp`] | DP-TBD: first order (Barniv 1985, Arnold et al. 1993), velocity-gated (Pulford, La Scala 2010), second order (Wang, Zhang 2016) | `[f32]`, one `M x M` image |
 pub mod bernoulli;
 pub mod crpf;
+pub mod dp;
 mod gauss_cloud;
 pub mod hough;
 mod interface;
