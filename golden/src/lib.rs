@@ -34,6 +34,7 @@ use core::fmt;
 
 pub mod cbmember;
 pub mod crpf;
+pub mod dp;
 pub mod phd;
 
 use faint_core::existence::ExistenceMarkov;
@@ -105,6 +106,7 @@ pub fn cases(emit: &mut dyn FnMut(&str, &[u32])) {
     crpf::cases(emit);
     phd::cases(emit);
     cbmember::cases(emit);
+    dp::cases(emit);
 }
 
 fn bits<const K: usize>(mut f: impl FnMut() -> f32) -> [u32; K] {

@@ -40,16 +40,20 @@ pub enum ScoreKind {
     Count,
     /// PHD mass of the extracted cluster (expected number of targets it holds).
     Mass,
+    /// Dynamic-programming merit: the summed score of the best track ending at the
+    /// detection, in the input's intensity units (DP-TBD).
+    Merit,
 }
 
 impl ScoreKind {
-    /// Short lowercase name (`existence`, `log_lr`, `count`, `mass`).
+    /// Short lowercase name (`existence`, `log_lr`, `count`, `mass`, `merit`).
     pub const fn name(self) -> &'static str {
         match self {
             ScoreKind::Existence => "existence",
             ScoreKind::LogLikelihoodRatio => "log_lr",
             ScoreKind::Count => "count",
             ScoreKind::Mass => "mass",
+            ScoreKind::Merit => "merit",
         }
     }
 }

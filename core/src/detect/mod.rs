@@ -7,9 +7,11 @@
 //! | [`mht`] | MHT-TBD (Bao et al. 2022), classic Hough TBD | `[Plot]`, one scan |
 //! | [`phd`] | SMC-PHD TBD with the PSO step (Pei et al. 2019) | `[f32]`, one power cube |
 //! | [`cbmember`] | CBMeMBer TBD, joint Doppler / micro-Doppler (rotor-UAV paper, 2023) | `[f32]` power, `[Complex32]` or `[u8]` range-Doppler map |
+//! | [`dp`] | DP-TBD: first order (Barniv 1985, Arnold et al. 1993), velocity-gated (Pulford, La Scala 2010), second order (Wang, Zhang 2016) | `[f32]`, one `M x M` image |
 pub mod bernoulli;
 pub mod cbmember;
 pub mod crpf;
+pub mod dp;
 mod gauss_cloud;
 mod interface;
 pub mod mht;

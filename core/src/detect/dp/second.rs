@@ -1,0 +1,531 @@
+//! Second-order DP over state pairs (Wang, Zhang 2016, §2, eq. 12-17).
+//!
+//! A state is a pair `(t, t')` of the positions at frames `k` and `k-1` with
+//! `t' in R_B(t)`, stored at pixel `t` as the displacement `d = t - t'` (index
+//! `(dy + R)(2R+1) + (dx + R)`, `q_B` states per pixel). With `e = t'' - (2 t' - t)`,
+//! the offset of `t''` from the back-extrapolated position (eq. 15):
+//!
+//! ```text
+//! I_1(t, .) = T(z_1(t)),  I_2(t, t') = T(z_2(t)) + T(z_1(t'))           (§2.3 step 1)
+//! I_k(t, t') = T(z_k(t)) + J_k(t', d),                                   k >= 3
+//! J_k(t', d) = max_{e in [-1,1]^2, d - e in R_B} [I_{k-1}(t', t' - (d - e)) + g(e)]   (eq. 14)
+//! ```
+//!
+//! `J_k(t', .)` depends only on the states stored at pixel `t'`, so it is computed per
+//! pixel (a 2-D optimisation over the `q_I = 9` candidates of each of the `q_B` states)
+//! and then scattered: `I_k(t' + d, d) = T(z_k(t' + d)) + J_k(t', d)`. Each candidate is
+//! one integer key `(I + g) << 4 | j` (`j` the candidate's index among the state's
+//! `n_d` valid ones, ascending `e = (ey + 1) 3 + (ex + 1)`): one compare-select per
+//! candidate, ties to the larger `j`. The back-pointer of state `(t', d)` is that `j`;
+//! the `q_B` pointers of a pixel are one mixed-radix code
+//! `(..(j_0 n_1 + j_1) n_2 + ..) + j_last` of `ceil(log2 prod n_d)` bits (22 bits for
+//! `q_B = 9`: `n_d` is 9 in the centre, 6 on the edges, 4 in the corners; 70 bits in
+//! three chunks below 2^32 for `q_B = 25`), packed into a bit stream per frame.
+//!
+//! Memory: `M^2 q_B sizeof(C)` merits, `5 M q_B sizeof(C)` bytes of `J` rows,
+//! `4 M` of a row buffer, and `4 W = (L - 2) ceil(M^2 b / 32) 4` bytes of back-pointers.
+//! For `M = 128`, `q_B = 9`, `L = 8`: `C = i16` 294 912 + 11 520 + 512 + 270 336 =
+//! 577 280 B (564 KiB); `C = i8` 147 456 + 5 760 + 512 + 270 336 = 424 064 B (414 KiB).
+
+use super::{
+    check_len, check_shape, detection, radius_of, read_bits, transition_table, BitWriter, DpConfig,
+    DpReport, DpTrack, Ends, MeritCell, Method, Quant, Tally, TrackEnd, STATE,
+};
+use crate::detect::{Detection, Detector, ScoreKind};
+use crate::{Error, Result};
+
+/// Largest supported `q_B` (5x5).
+pub(crate) const MAXQ: usize = 25;
+/// Rows of `J` kept (`2R + 1 <= 5`).
+const JROWS: usize = 5;
+const FLOOR_KEY: i32 = i32::MIN / 2;
+
+/// The state and pointer layout of one `q_B` (compile-time tables).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Layout {
+    /// Window radius (0: unsupported `q_B`).
+    pub(crate) r: usize,
+    /// Valid candidates `n_d` per state.
+    pub(crate) nopt: [u8; MAXQ],
+    /// Candidate `j` of state `d`: its `e` index `(ey + 1) 3 + (ex + 1)`.
+    pub(crate) opt_e: [[u8; 9]; MAXQ],
+    /// Candidate `j` of state `d`: the predecessor state `d - e`.
+    pub(crate) opt_s: [[u8; 9]; MAXQ],
+    /// Bit offset, in a pixel's code, of the chunk holding state `d`.
+    pub(crate) chunk_bit: [u16; MAXQ],
+    /// Bits of that chunk.
+    pub(crate) chunk_bits: [u8; MAXQ],
+    /// State `d` is the last of its chunk.
+    pub(crate) chunk_last: [bool; MAXQ],
+    /// Product of `n` over the later states of the chunk (the radix of `j_d`).
+    pub(crate) suffix: [u32; MAXQ],
+    /// Bits of one pixel's code.
+    pub(crate) bits: u32,
+}
+
+const fn bits_u64(n: u64) -> u32 {
+    let mut b = 0;
+    while b < 64 && (1u64 << b) < n {
+        b += 1;
+    }
+    b
+}
+
+/// The layout of `q_B = qb` (radius 1 or 2; anything else gives `r = 0`).
+pub(crate) const fn layout(qb: usize) -> Layout {
+    let mut l = Layout {
+        r: 0,
+        nopt: [0; MAXQ],
+        opt_e: [[0; 9]; MAXQ],
+        opt_s: [[0; 9]; MAXQ],
+        chunk_bit: [0; MAXQ],
+        chunk_bits: [0; MAXQ],
+        chunk_last: [false; MAXQ],
+        suffix: [1; MAXQ],
+        bits: 0,
+    };
+    let r = radius_of(qb);
+    if r == 0 || r > 2 {
+        return l;
+    }
+    l.r = r;
+    let n = 2 * r + 1;
+    let ri = r as i32;
+    let mut s = 0;
+    while s < qb {
+        let dx = (s % n) as i32 - ri;
+        let dy = (s / n) as i32 - ri;
+        let mut c = 0;
+        let mut ei = 0;
+        while ei < 9 {
+            let ex = (ei % 3) as i32 - 1;
+            let ey = (ei / 3) as i32 - 1;
+            let (px, py) = (dx - ex, dy - ey);
+            if px >= -ri && px <= ri && py >= -ri && py <= ri {
+                l.opt_e[s][c] = ei as u8;
+                l.opt_s[s][c] = ((py + ri) as usize * n + (px + ri) as usize) as u8;
+                c += 1;
+            }
+            ei += 1;
+        }
+        l.nopt[s] = c as u8;
+        s += 1;
+    }
+    // chunks: consecutive states whose radix product stays below 2^32
+    let mut off = 0u32;
+    let mut s = 0;
+    while s < qb {
+        let start = s;
+        let mut prod = 1u64;
+        while s < qb && prod * (l.nopt[s] as u64) < (1u64 << 32) {
+            prod *= l.nopt[s] as u64;
+            s += 1;
+        }
+        let bits = bits_u64(prod);
+        let mut t = start;
+        while t < s {
+            l.chunk_bit[t] = off as u16;
+            l.chunk_bits[t] = bits as u8;
+            let mut suf = 1u32;
+            let mut u = t + 1;
+            while u < s {
+                suf *= l.nopt[u] as u32;
+                u += 1;
+            }
+            l.suffix[t] = suf;
+            t += 1;
+        }
+        l.chunk_last[s - 1] = true;
+        off += bits;
+    }
+    l.bits = off;
+    l
+}
+
+/// Bits of one pixel's pointer code for `q_B = qb` (0 if unsupported).
+pub(crate) const fn code_bits(qb: usize) -> u32 {
+    layout(qb).bits
+}
+
+/// Second-order DP-TBD on `M x M` images with `q_B = QB` (9 or 25) state pairs per pixel
+/// and `q_I = 9`, tracks over `L` frames, `W = second_order_words(M, QB, L)`
+/// back-pointer words, merits stored as `C`.
+#[derive(Debug, Clone)]
+pub struct SecondOrderDp<
+    const M: usize,
+    const QB: usize,
+    const L: usize,
+    const W: usize,
+    C: MeritCell = i16,
+> {
+    cfg: DpConfig,
+    configured: bool,
+    quant: Quant,
+    tally: Tally,
+    ends: Ends,
+    g: [i32; 9],
+    s: [[[C; QB]; M]; M],
+    jring: [[[C; QB]; M]; JROWS],
+    zrow: [i32; M],
+    ptr: [u32; W],
+}
+
+impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCell>
+    SecondOrderDp<M, QB, L, W, C>
+{
+    const LAY: Layout = layout(QB);
+    const R: usize = Self::LAY.r;
+    const N: usize = 2 * Self::R + 1;
+    const BITS: usize = Self::LAY.bits as usize;
+    const WF: usize = (M * M * Self::BITS).div_ceil(32);
+    const LP: usize = L.saturating_sub(2);
+    const SHAPE: () = assert!(
+        W == Self::LP * Self::WF,
+        "W must be dp::second_order_words(M, QB, L)"
+    );
+
+    /// A detector for `cfg` (validated here).
+    pub fn new(cfg: DpConfig) -> Result<Self> {
+        let mut d = Self::unconfigured();
+        d.configure(&cfg, 0)?;
+        Ok(d)
+    }
+
+    /// A zeroed detector for `static` storage; `step` returns
+    /// `Error::InvalidConfig("unconfigured")` until [`Detector::configure`] succeeds.
+    pub const fn unconfigured() -> Self {
+        let () = Self::SHAPE;
+        Self {
+            cfg: DpConfig::dim_point(Method::SecondOrder, 1),
+            configured: false,
+            quant: Quant::zero(),
+            tally: Tally::new(),
+            ends: Ends::new(),
+            g: [0; 9],
+            s: [[[C::ZERO; QB]; M]; M],
+            jring: [[[C::ZERO; QB]; M]; JROWS],
+            zrow: [0; M],
+            ptr: [0; W],
+        }
+    }
+
+    /// The distinct track ends of the last frame, best first.
+    pub fn ends(&self) -> &[TrackEnd] {
+        self.ends.as_slice()
+    }
+
+    /// The transition term `g(e)` in LSB, index `(ey + 1) 3 + (ex + 1)`.
+    pub fn transition(&self) -> [i32; 9] {
+        self.g
+    }
+
+    /// Merit (intensity) of state `(t, t - d)` at pixel `t = (x, y)`, `d = (dx, dy)`.
+    pub fn pair_merit(&self, x: usize, y: usize, dx: i32, dy: i32) -> Option<f32> {
+        let r = Self::R as i32;
+        if self.tally.frames == 0 || dx.abs() > r || dy.abs() > r {
+            return None;
+        }
+        let s = ((dy + r) * (2 * r + 1) + dx + r) as usize;
+        let v = self.s.get(y)?.get(x)?.get(s)?.get();
+        Some(self.tally.merit(v, self.cfg.lsb))
+    }
+
+    /// Best state at a pixel: `(state, stored merit)`, ties to the lowest state index.
+    #[inline]
+    fn best_state(&self, x: usize, y: usize) -> Option<(usize, i32)> {
+        let cell = self.s.get(y)?.get(x)?;
+        let mut b = (0usize, i32::MIN);
+        for (i, c) in cell.iter().enumerate() {
+            if c.get() > b.1 {
+                b = (i, c.get());
+            }
+        }
+        Some(b)
+    }
+
+    #[inline]
+    fn raw(&self, x: usize, y: usize) -> Option<i32> {
+        self.best_state(x, y).map(|b| b.1)
+    }
+
+    /// `J` of merit row `rr` into its ring slot (`plain`: frame 2, `J = I`); with a
+    /// writer, appends the pixels' pointer codes.
+    fn j_row(
+        s: &[[[C; QB]; M]; M],
+        jring: &mut [[[C; QB]; M]; JROWS],
+        g: &[i32; 9],
+        rr: usize,
+        plain: bool,
+        bw: &mut Option<BitWriter<'_>>,
+    ) {
+        let lay = &Self::LAY;
+        let (Some(src), Some(dst)) = (s.get(rr), jring.get_mut(rr % JROWS)) else {
+            return;
+        };
+        if plain {
+            *dst = *src;
+            return;
+        }
+        for (cell, out) in src.iter().zip(dst.iter_mut()) {
+            let mut acc = 0u32;
+            for (d, o) in out.iter_mut().enumerate() {
+                let n = usize::from(lay.nopt[d]);
+                let mut v = FLOOR_KEY;
+                for j in 0..n {
+                    let e = usize::from(lay.opt_e[d][j]);
+                    let p = usize::from(lay.opt_s[d][j]);
+                    let base = cell.get(p).map_or(C::FLOOR, |c| c.get());
+                    let ge = g.get(e).copied().unwrap_or(0);
+                    let key = ((base + ge) << 4) | j as i32;
+                    v = v.max(key);
+                }
+                *o = C::sat(v >> 4);
+                acc = acc * n as u32 + (v & 15) as u32;
+                if lay.chunk_last[d] {
+                    if let Some(w) = bw.as_mut() {
+                        w.push(acc, u32::from(lay.chunk_bits[d]));
+                    }
+                    acc = 0;
+                }
+            }
+        }
+    }
+
+    fn run(&mut self, frame: &[f32], slow: bool) {
+        let k = self.tally.frames + 1;
+        let sub = if k == 1 { 0 } else { self.tally.best_raw };
+        let mut clamped = 0u32;
+        let mut best = i32::MIN;
+        let mut bxy = (0u16, 0u16);
+        if k == 1 {
+            for (y, (row, src)) in self.s.iter_mut().zip(frame.chunks_exact(M)).enumerate() {
+                clamped += self.quant.row(src, 0, slow, &mut self.zrow);
+                for (x, (cell, &q)) in row.iter_mut().zip(self.zrow.iter()).enumerate() {
+                    let c = C::sat(q);
+                    *cell = [c; QB];
+                    if c.get() > best {
+                        best = c.get();
+                        bxy = (x as u16, y as u16);
+                    }
+                }
+            }
+        } else {
+            let r = Self::R;
+            let n = Self::N;
+            let plain = k == 2;
+            let slot = if k >= 3 {
+                ((k - 3) as usize) % Self::LP.max(1)
+            } else {
+                0
+            };
+            let Self {
+                s: states,
+                jring,
+                ptr,
+                zrow,
+                quant,
+                g,
+                ..
+            } = self;
+            let words: &mut [u32] = if plain || Self::LP == 0 {
+                &mut []
+            } else {
+                ptr.get_mut(slot * Self::WF..(slot + 1) * Self::WF)
+                    .unwrap_or(&mut [])
+            };
+            let mut bw = if words.is_empty() {
+                None
+            } else {
+                Some(BitWriter::new(words))
+            };
+            for rr in 0..r.min(M) {
+                Self::j_row(states, jring, g, rr, plain, &mut bw);
+            }
+            for (y, src) in frame.chunks_exact(M).enumerate() {
+                if y + r < M {
+                    Self::j_row(states, jring, g, y + r, plain, &mut bw);
+                }
+                clamped += quant.row(src, sub, slow, zrow);
+                let Some(row) = states.get_mut(y) else {
+                    continue;
+                };
+                for (x, (cell, &zq)) in row.iter_mut().zip(zrow.iter()).enumerate() {
+                    for (s, c) in cell.iter_mut().enumerate() {
+                        let (dx, dy) = (s % n, s / n);
+                        let qx = (x + r).wrapping_sub(dx);
+                        let qy = (y + r).wrapping_sub(dy);
+                        let j = if qx < M && qy < M {
+                            jring
+                                .get(qy % JROWS)
+                                .and_then(|jr| jr.get(qx))
+                                .and_then(|jc| jc.get(s))
+                                .map_or(C::FLOOR, |v| v.get())
+                        } else {
+                            C::FLOOR
+                        };
+                        *c = C::sat(zq + j);
+                        if c.get() > best {
+                            best = c.get();
+                            bxy = (x as u16, y as u16);
+                        }
+                    }
+                }
+            }
+            if let Some(w) = bw {
+                w.finish();
+            }
+        }
+        self.tally.offset += i64::from(sub);
+        self.tally.best_raw = best;
+        self.tally.best_xy = bxy;
+        self.tally.clamped = clamped;
+        self.tally.frames = k;
+    }
+}
+
+impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCell> Detector
+    for SecondOrderDp<M, QB, L, W, C>
+{
+    type Frame = [f32];
+    type Config = DpConfig;
+    type Report = DpReport;
+    const STATE: &'static [&'static str] = STATE;
+    const SCORE: ScoreKind = ScoreKind::Merit;
+
+    /// Checks `cfg` (method `SecondOrder`, `L >= 1`, `q_B` 9 or 25 no larger than the
+    /// image), builds the transition table and restarts in place. `seed` is unused.
+    fn configure(&mut self, cfg: &DpConfig, _seed: u64) -> Result<()> {
+        let () = Self::SHAPE;
+        check_shape(cfg, Method::SecondOrder, M, Self::R, L)?;
+        let quant = Quant::new(cfg.lsb, C::ZMAX)?;
+        self.cfg = *cfg;
+        self.quant = quant;
+        self.g = transition_table(cfg);
+        self.configured = true;
+        self.reset(0);
+        Ok(())
+    }
+
+    fn config(&self) -> &DpConfig {
+        &self.cfg
+    }
+
+    fn reset(&mut self, _seed: u64) {
+        self.tally = Tally::new();
+        self.ends = Ends::new();
+    }
+
+    fn step(&mut self, frame: &[f32]) -> Result<DpReport> {
+        if !self.configured {
+            return Err(Error::InvalidConfig("unconfigured"));
+        }
+        check_len(frame, M)?;
+        let slow = self.quant.check(frame)?;
+        self.run(frame, slow);
+        let t = self.tally;
+        let lsb = self.cfg.lsb;
+        let mut ends = self.ends;
+        ends.fill(
+            M,
+            usize::from(self.cfg.top_k),
+            usize::from(self.cfg.separation),
+            t.best_xy,
+            &t,
+            lsb,
+            |x, y| self.raw(x, y).unwrap_or(i32::MIN),
+        );
+        self.ends = ends;
+        Ok(DpReport {
+            frame: t.frames,
+            best: TrackEnd {
+                x: t.best_xy.0,
+                y: t.best_xy.1,
+                merit: t.merit(t.best_raw, lsb),
+            },
+            clamped: t.clamped,
+        })
+    }
+
+    fn detection_count(&self) -> usize {
+        self.ends.n
+    }
+
+    fn detection(&self, i: usize) -> Option<Detection> {
+        detection::<Self, L>(self, &self.ends, i)
+    }
+}
+
+impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCell> DpTrack
+    for SecondOrderDp<M, QB, L, W, C>
+{
+    const SIDE: usize = M;
+    const HISTORY: usize = L;
+
+    fn frames(&self) -> u32 {
+        self.tally.frames
+    }
+
+    fn merit(&self, x: usize, y: usize) -> Option<f32> {
+        if self.tally.frames == 0 {
+            return None;
+        }
+        self.raw(x, y).map(|v| self.tally.merit(v, self.cfg.lsb))
+    }
+
+    /// From the best state at `(x, y)` (ties: lowest state index).
+    fn track(&self, x: usize, y: usize, out: &mut [[u16; 2]]) -> usize {
+        let k = self.tally.frames as usize;
+        let Some((mut d, _)) = self.best_state(x, y) else {
+            return 0;
+        };
+        if k == 0 {
+            return 0;
+        }
+        let n = out.len().min(L).min(k);
+        let (r, nn) = (Self::R, Self::N);
+        let lay = &Self::LAY;
+        // (px, py) = t_f, the newest position of the current pair state
+        let (mut px, mut py) = (x, y);
+        for j in 0..n {
+            if j == 0 {
+                if let Some(o) = out.get_mut(0) {
+                    *o = [px as u16, py as u16];
+                }
+                continue;
+            }
+            // predecessor pixel t_{f-1} = t_f - d
+            let qx = (px + r).wrapping_sub(d % nn);
+            let qy = (py + r).wrapping_sub(d / nn);
+            if qx >= M || qy >= M {
+                return j;
+            }
+            if let Some(o) = out.get_mut(j) {
+                *o = [qx as u16, qy as u16];
+            }
+            if j + 1 < n {
+                // pointer of frame f = k - j + 1 >= 3 at pixel t_{f-1}, state d
+                let f = k - j + 1;
+                let slot = (f - 3) % Self::LP.max(1);
+                let pix = (slot * Self::WF) * 32 + (qy * M + qx) * Self::BITS;
+                let (cb, cbits, suf, nopt) = (
+                    usize::from(lay.chunk_bit[d]),
+                    u32::from(lay.chunk_bits[d]),
+                    lay.suffix[d].max(1),
+                    u32::from(lay.nopt[d]).max(1),
+                );
+                let code = read_bits(&self.ptr, pix + cb, cbits);
+                let jj = ((code / suf) % nopt) as usize;
+                let Some(&next) = lay.opt_s.get(d).and_then(|o| o.get(jj)) else {
+                    return j + 1;
+                };
+                (px, py) = (qx, qy);
+                d = usize::from(next);
+            }
+        }
+        n
+    }
+
+    fn best(&self) -> Option<TrackEnd> {
+        self.ends.as_slice().first().copied()
+    }
+}
