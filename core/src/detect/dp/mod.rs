@@ -653,6 +653,7 @@ impl Ends {
     /// Fills the ends: the best (`best`), then up to `k - 1` more, each the best pixel
     /// (by `raw(x, y)`, ties first in row-major order) farther than `sep` (Chebyshev)
     /// from all chosen so far.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn fill(
         &mut self,
         m: usize,

@@ -81,13 +81,7 @@ impl Kf {
 /// Nearest integer (halves to even), clamped to `+-16384`.
 #[inline]
 fn round_i16(v: f32) -> i16 {
-    let v = if v > 16384.0 {
-        16384.0
-    } else if v < -16384.0 {
-        -16384.0
-    } else {
-        v
-    };
+    let v = v.clamp(-16384.0, 16384.0);
     ((v + MAGIC).to_bits() as i32).wrapping_sub(MAGIC_BITS) as i16
 }
 

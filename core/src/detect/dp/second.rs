@@ -98,8 +98,8 @@ pub(crate) const fn layout(qb: usize) -> Layout {
         let mut c = 0;
         let mut ei = 0;
         while ei < 9 {
-            let ex = (ei % 3) as i32 - 1;
-            let ey = (ei / 3) as i32 - 1;
+            let ex = ei % 3 - 1;
+            let ey = ei / 3 - 1;
             let (px, py) = (dx - ex, dy - ey);
             if px >= -ri && px <= ri && py >= -ri && py <= ri {
                 l.opt_e[s][c] = ei as u8;
