@@ -10,7 +10,7 @@
 //! use faint_core::detect::{run, Detector};
 //! use faint_core::Complex32;
 //!
-//! let mut det = CrpfTbd::<256>::new(CrpfConfig::othr(), 7).unwrap();
+//! let mut det = CrpfTbd::<256>::new(CrpfConfig::othr(), 7)?;
 //! // Ten frames of 32 complex bins (a user's recorded frames go here).
 //! let frames = vec![vec![Complex32::new(0.1, -0.2); 32]; 10];
 //! let mut last = 0.0;
@@ -19,9 +19,9 @@
 //!         // d.state() = [fd, fda, A] (CrpfTbd::STATE), d.score = existence probability
 //!         last = d.score;
 //!     }
-//! })
-//! .unwrap();
+//! })?;
 //! assert!((0.0..=1.0).contains(&last));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 use crate::{Error, Result};
