@@ -4,5 +4,6 @@
 #![allow(clippy::needless_range_loop)]
 
 mod calibration;
+mod cli;
 mod detector;
 mod model;

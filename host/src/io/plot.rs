@@ -77,11 +77,22 @@ fn chart(
             .iter()
             .flat_map(|s| s.points.iter().filter(|p| shown(p)).map(|p| p.0)),
     )?;
-    let (y0, y1) = range(
+    let ys = || {
         series
             .iter()
-            .flat_map(|s| s.points.iter().filter(|p| shown(p)).map(|p| p.1)),
-    )?;
+            .flat_map(|s| s.points.iter().filter(|p| shown(p)).map(|p| p.1))
+    };
+    // Linear axes pad the range; a log axis takes the shown (positive) values alone: padding
+    // below zero and clamping to f64::MIN_POSITIVE made plotters' tick search never end.
+    let (y0, y1) = if log_y {
+        ensure!(
+            ys().next().is_some(),
+            "nothing positive to plot on a log axis"
+        );
+        ys().fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)))
+    } else {
+        range(ys())?
+    };
     let root = SVGBackend::new(path, (900, 600)).into_drawing_area();
     let e = |e: DrawingAreaErrorKind<_>| anyhow!("plotting {}: {e:?}", path.display());
     root.fill(&WHITE).map_err(e)?;
@@ -123,8 +134,7 @@ fn chart(
         }};
     }
     if log_y {
-        let (lo, hi) = (y0.max(f64::MIN_POSITIVE), y1.max(f64::MIN_POSITIVE));
-        draw!(builder.build_cartesian_2d(x0..x1, (lo * 0.8..hi * 1.25).log_scale()));
+        draw!(builder.build_cartesian_2d(x0..x1, (y0 * 0.8..y1 * 1.25).log_scale()));
     } else {
         draw!(builder.build_cartesian_2d(x0..x1, y0..y1));
     }
@@ -346,6 +356,19 @@ mod tests {
         )
         .unwrap();
         assert!(line_chart(dir.join("e.svg"), "t", "x", "y", &[]).is_err());
+        // Regression: a log axis over small rates and zeros (Fig. 10 of the MHT-TBD
+        // reproduction) once never finished.
+        line_chart_log_y(
+            dir.join("log.svg"),
+            "rates",
+            "x",
+            "rate",
+            &[Series {
+                name: "r".into(),
+                points: vec![(0.0, 0.0), (1.0, 1e-4), (2.0, 3e-3), (3.0, 0.0)],
+            }],
+        )
+        .unwrap();
         let track = [Series {
             name: "track".into(),
             points: vec![(0.5, 0.5)],
