@@ -2,4 +2,5 @@
 //! recursions against exhaustive search, bad input, and properties. One test binary for
 //! the family.
 
+mod analysis;
 mod detector;
