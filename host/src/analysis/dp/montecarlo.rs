@@ -225,7 +225,9 @@ pub fn target_starts(m: usize, r: usize, step: (i32, i32), frames: usize) -> Vec
 }
 
 /// Per-frame detection rates of targets of amplitude `amp` moving by `step` pixels per
-/// frame, `images` independent runs (each holding [`target_starts`] targets).
+/// frame over `images` independent runs (each holding [`target_starts`] targets), at each
+/// of the threshold sequences `thresholds` (all of one length: the frames), on the same
+/// runs.
 #[allow(clippy::too_many_arguments)]
 pub fn target_rates<D, F>(
     make: F,
@@ -233,21 +235,25 @@ pub fn target_rates<D, F>(
     r: usize,
     step: (i32, i32),
     amp: f32,
-    thresholds: &[f32],
+    thresholds: &[&[f32]],
     images: usize,
     seed: u64,
-) -> Result<Vec<Rate>>
+) -> Result<Vec<Vec<Rate>>>
 where
     D: DpTrack,
     F: Fn() -> Box<D> + Sync,
 {
     let m = D::SIDE;
-    let n = thresholds.len();
+    let n = thresholds.first().map_or(0, |t| t.len());
+    if thresholds.iter().any(|t| t.len() != n) {
+        bail!("target check: threshold sequences of different lengths");
+    }
     let starts = target_starts(m, r, step, n.max(1));
     if starts.is_empty() || n == 0 || images == 0 {
         bail!("target check: no target track of {n} frames fits an {m} x {m} image");
     }
-    let hits: Vec<Result<Vec<usize>>> = pool()?.install(|| {
+    // hits[image][frame][threshold set]
+    let hits: Vec<Result<Vec<Vec<usize>>>> = pool()?.install(|| {
         (0..images)
             .into_par_iter()
             .map(|i| {
@@ -256,7 +262,7 @@ where
                 let mut rng = Rng::from_stream(seed, i as u64);
                 let mut z = vec![0f32; m * m];
                 let mut out = Vec::with_capacity(n);
-                for (k, &vt) in thresholds.iter().enumerate() {
+                for k in 0..n {
                     noise_frame(&mut rng, cfg.sigma, &mut z);
                     let pos = |&(x, y): &(usize, usize)| {
                         let px = x as i64 + i64::from(step.0) * k as i64;
@@ -270,30 +276,44 @@ where
                         }
                     }
                     det.step(&z).map_err(|e| anyhow::anyhow!("{e}"))?;
-                    let hit = starts
+                    let merits: Vec<Option<f32>> = starts
                         .iter()
-                        .filter(|s| {
+                        .map(|s| {
                             let (x, y) = pos(s);
-                            det.merit(x, y).is_some_and(|v| v >= vt)
+                            det.merit(x, y)
                         })
-                        .count();
-                    out.push(hit);
+                        .collect();
+                    out.push(
+                        thresholds
+                            .iter()
+                            .map(|t| {
+                                merits
+                                    .iter()
+                                    .filter(|v| v.is_some_and(|v| v >= t[k]))
+                                    .count()
+                            })
+                            .collect(),
+                    );
                 }
                 Ok(out)
             })
             .collect()
     });
-    let hits: Vec<Vec<usize>> = hits.into_iter().collect::<Result<_>>()?;
+    let hits: Vec<Vec<Vec<usize>>> = hits.into_iter().collect::<Result<_>>()?;
     let total = images * starts.len();
-    Ok((0..n)
-        .map(|k| {
-            let h: usize = hits.iter().map(|v| v[k]).sum();
-            let p = h as f64 / total as f64;
-            Rate {
-                rate: p,
-                se: (p * (1.0 - p) / total as f64).sqrt(),
-                samples: total,
-            }
+    Ok((0..thresholds.len())
+        .map(|j| {
+            (0..n)
+                .map(|k| {
+                    let h: usize = hits.iter().map(|v| v[k][j]).sum();
+                    let p = h as f64 / total as f64;
+                    Rate {
+                        rate: p,
+                        se: (p * (1.0 - p) / total as f64).sqrt(),
+                        samples: total,
+                    }
+                })
+                .collect()
         })
         .collect())
 }
@@ -351,22 +371,20 @@ pub fn check(
                 derive_seed(seed, 1),
             )?;
             let cal: Vec<f32> = noise.iter().map(|p| p.calibrated).collect();
-            let at = |th: &[f32], s: u64| {
-                target_rates(
-                    || Box::new(<$t>::unconfigured()),
-                    cfg,
-                    $r,
-                    setup.step,
-                    amp,
-                    th,
-                    target_images,
-                    derive_seed(seed, s),
-                )
-            };
-            // the same target runs (seed) at both thresholds
+            let mut pd = target_rates(
+                || Box::new(<$t>::unconfigured()),
+                cfg,
+                $r,
+                setup.step,
+                amp,
+                &[vt, &cal],
+                target_images,
+                derive_seed(seed, 2),
+            )?
+            .into_iter();
             Check {
-                pd_analytic_vt: at(vt, 2)?,
-                pd_calibrated_vt: at(&cal, 2)?,
+                pd_analytic_vt: pd.next().unwrap_or_default(),
+                pd_calibrated_vt: pd.next().unwrap_or_default(),
                 noise,
             }
         }};
