@@ -8,8 +8,9 @@
 //!
 //! The configuration file is JSON: `{"config": {...}}` holding the core configuration
 //! (e.g. `CrpfConfig`), plus `"particles"` for the particle filters (one of
-//! [`PARTICLES`]) and `"estimate_noise"` for the Gaussian comparators. Unknown keys are
-//! rejected; values are checked by the core's own `validate`.
+//! [`PARTICLES`]), `"estimate_noise"` for the Gaussian comparators and `"q_b"` for
+//! DP-TBD ([`DpFile`]). Unknown keys are rejected; values are checked by the core's own
+//! `validate`.
 //!
 //! Outputs ([`write()`]): `detections.csv` / `detections.json` (frame, detector, score,
 //! track id and length, state), `summary.csv` (per frame: detections and best score),
