@@ -1,8 +1,10 @@
 //! DP-TBD (Barniv 1985, Arnold et al. 1993; Pulford, La Scala 2010; Wang, Zhang 2016): the
-//! recursions against exhaustive search, bad input, and properties; the host layer's
+//! recursions against exhaustive search, bad input, and properties; the merit-distribution
+//! analysis; the host layer's
 //! `dim-point` scene, `faint simulate dim-point` + `faint detect dp-*` round trip and
 //! `faint reproduce dp --quick`. One test binary for the family.
 
+mod analysis;
 mod cli;
 mod detector;
 mod host;

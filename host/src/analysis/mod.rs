@@ -1,2 +1,3 @@
 //! Closed-form detection models.
+pub mod dp;
 pub mod mht;
