@@ -28,7 +28,15 @@ fn reproduce_dp_quick_writes_every_output() {
 fn quick_never_overrides_a_given_value() {
     let dir = temp("quick-runs");
     let (code, _, err) = faint(&[
-        "reproduce", "dp", "--quick", "--runs", "2", "--snr", "3:3:1", "--no-fig5", "--out",
+        "reproduce",
+        "dp",
+        "--quick",
+        "--runs",
+        "2",
+        "--snr",
+        "3:3:1",
+        "--no-fig5",
+        "--out",
         s(&dir),
     ]);
     assert_eq!(code, 0, "{err}");

@@ -113,10 +113,16 @@ fn dp_detectors_round_trip() {
     }
     let mut a = boxed::<Arnold9>(&DpConfig::dim_point(Method::Arnold, 1)).unwrap();
     let want = rows_of(a.as_mut(), &run0.frames);
-    assert_eq!(detect("dp-arnold", &file, &dir.join("arnold"), &truth), want);
+    assert_eq!(
+        detect("dp-arnold", &file, &dir.join("arnold"), &truth),
+        want
+    );
     let mut p = boxed::<Pulford9>(&DpConfig::dim_point(Method::Pulford, 1)).unwrap();
     let want = rows_of(p.as_mut(), &run0.frames);
-    assert_eq!(detect("dp-pulford", &file, &dir.join("pulford"), &truth), want);
+    assert_eq!(
+        detect("dp-pulford", &file, &dir.join("pulford"), &truth),
+        want
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -192,14 +198,28 @@ fn bad_dp_inputs_are_one_clear_line() {
     v["q_b"] = 49.into();
     std::fs::write(&cfg, v.to_string()).unwrap();
     fails(
-        &["detect", "dp-second", "--input", s(&small), "--config", s(&cfg)],
+        &[
+            "detect",
+            "dp-second",
+            "--input",
+            s(&small),
+            "--config",
+            s(&cfg),
+        ],
         &["cfg.json", "q_b = 49"],
     );
     v["q_b"] = 9.into();
     v["config"]["method"] = "Arnold".into();
     std::fs::write(&cfg, v.to_string()).unwrap();
     fails(
-        &["detect", "dp-second", "--input", s(&small), "--config", s(&cfg)],
+        &[
+            "detect",
+            "dp-second",
+            "--input",
+            s(&small),
+            "--config",
+            s(&cfg),
+        ],
         &["cfg.json", "method"],
     );
     let _ = std::fs::remove_dir_all(&dir);

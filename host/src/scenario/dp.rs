@@ -43,11 +43,9 @@ pub type Pulford9 = PulfordDp<SIDE, 9, HISTORY, { pulford_words(SIDE, 9, HISTORY
 /// Pulford, `q_B = 25`.
 pub type Pulford25 = PulfordDp<SIDE, 25, HISTORY, { pulford_words(SIDE, 25, HISTORY) }>;
 /// Second order, `q_B = 9`.
-pub type Second9 =
-    SecondOrderDp<SIDE, 9, HISTORY, { second_order_words(SIDE, 9, HISTORY) }>;
+pub type Second9 = SecondOrderDp<SIDE, 9, HISTORY, { second_order_words(SIDE, 9, HISTORY) }>;
 /// Second order, `q_B = 25`.
-pub type Second25 =
-    SecondOrderDp<SIDE, 25, HISTORY, { second_order_words(SIDE, 25, HISTORY) }>;
+pub type Second25 = SecondOrderDp<SIDE, 25, HISTORY, { second_order_words(SIDE, 25, HISTORY) }>;
 
 /// A configured DP detector built on the heap: zeroed in place (the `q_B = 25` second
 /// order is 6.2 MB, more than a thread's stack), then configured with `cfg`.
@@ -65,8 +63,8 @@ pub fn boxed<D: DpTrack>(cfg: &DpConfig) -> Result<Box<D>> {
 /// configured with `$cfg`; another `q_B` is an error naming it.
 macro_rules! with_dp {
     ($method:expr, $qb:expr, $cfg:expr, |$det:ident| $body:expr) => {{
-        use $crate::scenario::dp as sdp;
         use faint_core::detect::dp::Method as M_;
+        use $crate::scenario::dp as sdp;
         match ($method, $qb) {
             (M_::Arnold, 9) => {
                 let $det = sdp::boxed::<sdp::Arnold9>($cfg)?;
@@ -202,7 +200,9 @@ impl DimPoint {
             );
             o.insert(
                 "target".into(),
-                serde_json::json!("whole amplitude a = SNR sigma in the pixel holding the continuous position"),
+                serde_json::json!(
+                    "whole amplitude a = SNR sigma in the pixel holding the continuous position"
+                ),
             );
             o.insert(
                 "streams".into(),
@@ -237,10 +237,7 @@ impl DimPoint {
             self.frames
         );
         for _ in 0..100_000 {
-            let start = [
-                m * f64::from(rng.uniform()),
-                m * f64::from(rng.uniform()),
-            ];
+            let start = [m * f64::from(rng.uniform()), m * f64::from(rng.uniform())];
             let h = std::f64::consts::TAU * f64::from(rng.uniform());
             let velocity = [speed * h.cos(), speed * h.sin()];
             let t = Truth { start, velocity };
@@ -255,7 +252,14 @@ impl DimPoint {
 
     /// Frame `k` into `out` (`side^2` values, row-major): noise, plus `amp` at the
     /// target's pixel when `truth` is given.
-    pub fn frame(&self, truth: Option<&Truth>, amp: f32, k: usize, rng: &mut Rng, out: &mut Vec<f32>) {
+    pub fn frame(
+        &self,
+        truth: Option<&Truth>,
+        amp: f32,
+        k: usize,
+        rng: &mut Rng,
+        out: &mut Vec<f32>,
+    ) {
         out.clear();
         out.extend((0..self.side * self.side).map(|_| self.sigma * rng.normal()));
         if let Some(t) = truth {

@@ -153,12 +153,7 @@ pub fn target_run(
 }
 
 /// The three methods' best merits after every frame of a noise-only run.
-pub fn noise_run(
-    sc: &DimPoint,
-    speed: u8,
-    v: &Variant,
-    rng: &mut Rng,
-) -> Result<Vec<Vec<f32>>> {
+pub fn noise_run(sc: &DimPoint, speed: u8, v: &Variant, rng: &mut Rng) -> Result<Vec<Vec<f32>>> {
     let run = sc.run(None, speed, rng)?;
     let qb = v.qb(speed)?;
     METHODS

@@ -306,7 +306,11 @@ pub fn first_detection(t: &Trace, th: &Thresholds, level: Level) -> Option<usize
 
 /// Image-level thresholds of every method from the calibration runs, checked on the
 /// independent check runs (`[run][method][frame]` best merits).
-fn image_thresholds(cal: &[Vec<Vec<f32>>], check: &[Vec<Vec<f32>>], frames: usize) -> Result<Vec<Thresholds>> {
+fn image_thresholds(
+    cal: &[Vec<Vec<f32>>],
+    check: &[Vec<Vec<f32>>],
+    frames: usize,
+) -> Result<Vec<Thresholds>> {
     let mut out = Vec::new();
     for mi in 0..METHODS.len() {
         let mut image = Vec::with_capacity(frames);
@@ -349,12 +353,20 @@ struct SpeedResult {
 fn run_speed(sc: &DimPoint, e: &Effective, seed: u64, speed: u8) -> Result<SpeedResult> {
     let v = e.variant;
     let noise = |master: u64, label: &str| -> Result<Vec<Vec<Vec<f32>>>> {
-        run_trials(master, e.noise_runs, label, |_, rng| noise_run(sc, speed, &v, rng))
-            .into_iter()
-            .collect()
+        run_trials(master, e.noise_runs, label, |_, rng| {
+            noise_run(sc, speed, &v, rng)
+        })
+        .into_iter()
+        .collect()
     };
-    let cal = noise(DimPoint::calibration_seed(seed, speed), &format!("dp noise {speed} px"))?;
-    let check = noise(DimPoint::check_seed(seed, speed), &format!("dp check {speed} px"))?;
+    let cal = noise(
+        DimPoint::calibration_seed(seed, speed),
+        &format!("dp noise {speed} px"),
+    )?;
+    let check = noise(
+        DimPoint::check_seed(seed, speed),
+        &format!("dp check {speed} px"),
+    )?;
     let mut thresholds = image_thresholds(&cal, &check, sc.frames)?;
     let qb = v.qb(speed)?;
     for (t, &m) in thresholds.iter_mut().zip(&METHODS) {
