@@ -85,10 +85,10 @@ struct DetectArgs {
 
 #[derive(clap::Args, Debug)]
 struct SimulateArgs {
-    /// Scenario preset: othr, sea-clutter, six-targets or rotor-uav.
+    /// Scenario preset: othr, sea-clutter, six-targets, rotor-uav or dim-point.
     scenario: String,
-    /// Frames file to write (.npy for othr and six-targets, .csv for sea-clutter); the
-    /// truth goes beside it as <stem>.truth.csv.
+    /// Frames file to write (.npy for othr, six-targets, rotor-uav and dim-point, .csv for
+    /// sea-clutter); the truth goes beside it as <stem>.truth.csv.
     #[arg(long)]
     out: PathBuf,
     /// Seed.
@@ -104,6 +104,12 @@ struct SimulateArgs {
     /// Clutter plots per scan (sea-clutter) [default: 80].
     #[arg(long)]
     lambda: Option<f32>,
+    /// SNR `a / sigma`, linear (dim-point) [default: 2].
+    #[arg(long)]
+    snr: Option<f64>,
+    /// Target speed in px/frame, 1 or 2 (dim-point) [default: 1].
+    #[arg(long)]
+    speed: Option<u8>,
     /// Background noise (othr).
     #[arg(long, value_enum, default_value = "gaussian")]
     noise: faint::host::scenario::crpf::Noise,
@@ -120,6 +126,8 @@ enum Reproduce {
     Phd(faint::host::reproduce::phd::Args),
     /// CBMeMBer TBD, joint Doppler / micro-Doppler vs Doppler-only (rotor-UAV paper, 2023).
     Cbmember(faint::host::reproduce::cbmember::Args),
+    /// DP-TBD: second-order DP vs Arnold and Pulford first-order DP (Wang, Zhang 2016, Fig. 5-7).
+    Dp(faint::host::reproduce::dp::Args),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -145,6 +153,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 snr_db: a.snr_db,
                 frames: a.frames,
                 lambda: a.lambda,
+                snr: a.snr,
+                speed: a.speed,
                 noise: a.noise,
             })?;
             println!(
@@ -160,6 +170,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             Reproduce::Mht(a) => faint::host::reproduce::mht::run(&a),
             Reproduce::Phd(a) => faint::host::reproduce::phd::run(&a),
             Reproduce::Cbmember(a) => faint::host::reproduce::cbmember::run(&a),
+            Reproduce::Dp(a) => faint::host::reproduce::dp::run(&a),
         },
     }
 }

@@ -7,12 +7,16 @@
 //! | `sea-clutter` | CSV `scan,amplitude,x,y` | `frame,x_m,y_m` | one scan (periods of 30 scans follow each other) |
 //! | `six-targets` | `(K, 142, 150, 90)` float32 `.npy` | `frame,x_m,y_m` | one power cube (at most the preset's 40) |
 //! | `rotor-uav` | `(K, 256, 512)` float32 `.npy` power maps | `frame,range_m,velocity_m_per_s` | one range-Doppler map (at most the preset's 40) |
+//! | `dim-point` | `(K, 128, 128)` float32 `.npy` intensity images | `frame,x_px,y_px` | one image (at most the preset's 40) |
 //!
 //! Run `r` of a multi-run file (`othr`, `sea-clutter`) draws from `Rng::from_stream(seed, r)`,
 //! the stream trial `r` of a reproduction with master seed `seed` gets; `six-targets`
 //! draws its truth from `Rng::from_stream(seed, 0).fork(1)` and its cubes from `.fork(2)`,
 //! as the reproduction's run 0 does; `rotor-uav` its maps from
-//! `Rng::from_stream(seed, 0).fork(1)` (the reproduction's map stream of a run).
+//! `Rng::from_stream(seed, 0).fork(1)` (the reproduction's map stream of a run);
+//! `dim-point` draws run 0 at `--speed` from
+//! `Rng::from_stream(derive_seed(seed, speed), 0)`, the reproduction's run 0 at that speed
+//! (truth: the continuous position, pixel `(x, y)` covering `[x, x+1) x [y, y+1)`).
 
 use std::path::{Path, PathBuf};
 
@@ -24,6 +28,7 @@ use crate::io::output::{write_complex_frames, write_plots, write_real_frames};
 use crate::io::write_csv;
 use crate::scenario::cbmember::{MapSource, RotorUav};
 use crate::scenario::crpf::{Noise, Othr};
+use crate::scenario::dp::{qb_for, DimPoint};
 use crate::scenario::mht::SeaClutter;
 use crate::scenario::phd::SixTargets;
 
@@ -43,6 +48,10 @@ pub struct Spec {
     pub frames: Option<usize>,
     /// Clutter plots per scan (`sea-clutter`, default 80).
     pub lambda: Option<f32>,
+    /// SNR `a / sigma`, linear (`dim-point`, default 2).
+    pub snr: Option<f64>,
+    /// Target speed in px/frame (`dim-point`, 1 or 2, default 1).
+    pub speed: Option<u8>,
     /// Background noise (`othr`, default Gaussian).
     pub noise: Noise,
 }
@@ -69,6 +78,13 @@ struct RangeVelocity {
     frame: usize,
     range_m: f64,
     velocity_m_per_s: f64,
+}
+
+#[derive(Serialize)]
+struct XyPx {
+    frame: usize,
+    x_px: f64,
+    y_px: f64,
 }
 
 #[derive(Serialize)]
@@ -132,10 +148,34 @@ pub fn check(spec: &Spec) -> Result<()> {
             }
             extension_is(&spec.out, "npy", "six-targets")
         }
+        "dim-point" => {
+            let max = DimPoint::default().frames;
+            if let Some(k) = spec.frames {
+                ensure!(k <= max, "--frames {k}: dim-point has {max} frames");
+            }
+            ensure!(
+                spec.snr_db.is_none(),
+                "--snr-db: dim-point's SNR is the linear a / sigma (use --snr)"
+            );
+            if let Some(s) = spec.snr {
+                ensure!(
+                    (0.0..=100.0).contains(&s),
+                    "--snr {s}: must lie in [0, 100] (a / sigma)"
+                );
+            }
+            if let Some(v) = spec.speed {
+                qb_for(v).map_err(|e| anyhow::anyhow!("--speed: {e}"))?;
+            }
+            extension_is(&spec.out, "npy", "dim-point")
+        }
         other => {
-            bail!("unknown scenario '{other}' for simulate; known: othr, sea-clutter, six-targets")
+            bail!("unknown scenario '{other}' for simulate; known: othr, sea-clutter, six-targets, rotor-uav, dim-point")
         }
     }?;
+    if spec.scenario != "dim-point" {
+        ensure!(spec.snr.is_none(), "--snr: only dim-point (use --snr-db)");
+        ensure!(spec.speed.is_none(), "--speed: only dim-point has a speed");
+    }
     if spec.scenario != "sea-clutter" {
         ensure!(
             spec.lambda.is_none(),
@@ -224,6 +264,29 @@ pub fn simulate(spec: &Spec) -> Result<Simulated> {
                 });
             }
             write_real_frames(&spec.out, &[k, g.n_range, g.n_velocity], &data)?;
+            write_csv(&truth_path, &truth)?;
+            k
+        }
+        "dim-point" => {
+            let sc = DimPoint::default();
+            let k = spec.frames.unwrap_or(sc.frames);
+            let speed = spec.speed.unwrap_or(1);
+            let mut rng = Rng::from_stream(DimPoint::target_seed(spec.seed, speed), 0);
+            let run = sc.run(Some(spec.snr.unwrap_or(2.0)), speed, &mut rng)?;
+            let mut data = Vec::with_capacity(k * sc.side * sc.side);
+            let mut truth = Vec::new();
+            for (f, z) in run.frames.iter().take(k).enumerate() {
+                data.extend_from_slice(z);
+                if let Some(t) = &run.truth {
+                    let p = t.position(f);
+                    truth.push(XyPx {
+                        frame: f,
+                        x_px: p[0],
+                        y_px: p[1],
+                    });
+                }
+            }
+            write_real_frames(&spec.out, &[k, sc.side, sc.side], &data)?;
             write_csv(&truth_path, &truth)?;
             k
         }

@@ -8,8 +8,9 @@
 //!
 //! The configuration file is JSON: `{"config": {...}}` holding the core configuration
 //! (e.g. `CrpfConfig`), plus `"particles"` for the particle filters (one of
-//! [`PARTICLES`]) and `"estimate_noise"` for the Gaussian comparators. Unknown keys are
-//! rejected; values are checked by the core's own `validate`.
+//! [`PARTICLES`]), `"estimate_noise"` for the Gaussian comparators and `"q_b"` for
+//! DP-TBD ([`DpFile`]). Unknown keys are rejected; values are checked by the core's own
+//! `validate`.
 //!
 //! Outputs ([`write()`]): `detections.csv` / `detections.json` (frame, detector, score,
 //! track id and length, state), `summary.csv` (per frame: detections and best score),
@@ -22,6 +23,7 @@ use anyhow::{anyhow, bail, ensure, Context, Result};
 use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::cbmember::CbmemberConfig;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint_core::detect::dp::{DpConfig, DpReport, Method};
 use faint_core::detect::mht::{ClassicHoughConfig, MhtConfig};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
@@ -38,6 +40,7 @@ use crate::io::input::{read_complex_frames, read_plots, read_real_frames, Frames
 use crate::montecarlo::progress_bar;
 use crate::reproduce::mht::{Classic, Mht};
 use crate::scenario::cbmember::HostFilter as CbmemberHost;
+use crate::scenario::dp::with_dp;
 use crate::scenario::mht::SeaClutter;
 use crate::scenario::phd::{HostFilter, SixTargets, Variant};
 use crate::timing::thread_cpu_seconds as cpu;
@@ -61,6 +64,9 @@ pub enum InputKind {
     PowerCubes,
     /// `(K, Nr, Nv)` float32 `.npy`/`.npz`: one range x velocity power map `|y|^2` per frame.
     PowerMaps,
+    /// `(K, M, M)` float32 `.npy`/`.npz`: one square intensity image per frame (row-major,
+    /// pixel `(x, y)` = (column, row)).
+    Images,
 }
 
 impl InputKind {
@@ -71,6 +77,7 @@ impl InputKind {
             InputKind::Plots => "CSV scan,amplitude,x,y",
             InputKind::PowerCubes => "(K, R, D, A) float32 .npy/.npz power cubes",
             InputKind::PowerMaps => "(K, Nr, Nv) float32 .npy/.npz range-Doppler power maps |y|^2",
+            InputKind::Images => "(K, 128, 128) float32 .npy/.npz intensity images",
         }
     }
 }
@@ -258,7 +265,109 @@ pub const REGISTRY: &[Entry] = &[
         default_config: || default_cbmember(PointModel::DopplerOnly),
         run: |r| run_cbmember(r, "cbmember-doppler", PointModel::DopplerOnly),
     },
+    Entry {
+        name: "dp-arnold",
+        about: "first-order DP-TBD, hard q_B window (Barniv 1985; Arnold et al. 1993)",
+        input: InputKind::Images,
+        default_config: || default_dp(Method::Arnold),
+        run: |r| run_dp(r, "dp-arnold", Method::Arnold),
+    },
+    Entry {
+        name: "dp-pulford",
+        about: "first-order DP-TBD, Kalman velocity gate (Pulford, La Scala 2010)",
+        input: InputKind::Images,
+        default_config: || default_dp(Method::Pulford),
+        run: |r| run_dp(r, "dp-pulford", Method::Pulford),
+    },
+    Entry {
+        name: "dp-second",
+        about: "second-order DP-TBD over state pairs (Wang, Zhang 2016)",
+        input: InputKind::Images,
+        default_config: || default_dp(Method::SecondOrder),
+        run: |r| run_dp(r, "dp-second", Method::SecondOrder),
+    },
 ];
+
+/// A DP-TBD detector's configuration file: `q_B` (9 or 25, compiled in) and the core
+/// configuration; `M = 128` and `L = 40` are compiled in.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DpFile {
+    /// Predecessor window `q_B`: 9 (3 x 3, up to 1 px/frame) or 25 (5 x 5, up to 2).
+    pub q_b: usize,
+    /// The core configuration.
+    pub config: DpConfig,
+}
+
+fn default_dp(method: Method) -> String {
+    json(&DpFile {
+        q_b: 9,
+        config: DpConfig::dim_point(method, 1),
+    })
+}
+
+/// A DP report as one line of `reports.json`.
+#[derive(Serialize)]
+struct DpReportJson {
+    frame: u32,
+    best_x: u16,
+    best_y: u16,
+    best_merit: f32,
+    clamped: u32,
+}
+
+fn dp_report_json(r: &DpReport) -> String {
+    serde_json::to_string(&DpReportJson {
+        frame: r.frame,
+        best_x: r.best.x,
+        best_y: r.best.y,
+        best_merit: r.best.merit,
+        clamped: r.clamped,
+    })
+    .unwrap_or_default()
+}
+
+fn run_dp(req: &Request, name: &'static str, method: Method) -> Result<Outcome> {
+    let t = cpu();
+    let default = find_default(name);
+    let file: DpFile = load(req, default, |f: &DpFile| {
+        ensure!(
+            f.q_b == 9 || f.q_b == 25,
+            "q_b = {}: must be 9 or 25 (compiled in)",
+            f.q_b
+        );
+        ensure!(
+            f.config.method == method,
+            "config.method is {:?}; {name} runs {:?}",
+            f.config.method,
+            method
+        );
+        valid(&f.config)
+    })?;
+    let images = read_real_frames(req.input, 3)?;
+    let m = crate::scenario::dp::SIDE;
+    ensure!(
+        images.shape[1..] == [m, m],
+        "{}: images of shape {:?}, the DP detectors are built for (K, {m}, {m})",
+        req.input.display(),
+        images.shape
+    );
+    let read = cpu() - t;
+    let cfg = file.config;
+    let mut out = with_dp!(method, file.q_b, &cfg, |det| {
+        let mut det = det;
+        drive_with(
+            name,
+            det.as_mut(),
+            (0..images.frames()).map(|k| images.frame(k)),
+            req,
+            XY_POSITION,
+            dp_report_json,
+        )?
+    });
+    out.read_seconds = read;
+    Ok(out)
+}
 
 fn default_cbmember(model: PointModel) -> String {
     json(&Plain {
@@ -467,6 +576,24 @@ where
     D::Frame: 'f,
     D::Report: Serialize,
 {
+    drive_with(name, det, frames, req, position, |r| {
+        serde_json::to_string(r).unwrap_or_default()
+    })
+}
+
+/// [`drive`] with the report written as JSON by `report_json`.
+fn drive_with<'f, D>(
+    name: &'static str,
+    det: &mut D,
+    frames: impl ExactSizeIterator<Item = &'f D::Frame>,
+    req: &Request,
+    position: &'static [usize],
+    report_json: impl Fn(&D::Report) -> String,
+) -> Result<Outcome>
+where
+    D: Detector,
+    D::Frame: 'f,
+{
     let n = frames.len();
     let input = req.input;
     let keep_reports = req.reports;
@@ -487,7 +614,7 @@ where
             });
         }
         if keep_reports {
-            reports.push(serde_json::to_string(report).unwrap_or_default());
+            reports.push(report_json(report));
         }
         if k % 64 == 0 {
             pb.set_position(k as u64);

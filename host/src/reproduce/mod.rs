@@ -4,5 +4,6 @@
 
 pub mod cbmember;
 pub mod crpf;
+pub mod dp;
 pub mod mht;
 pub mod phd;

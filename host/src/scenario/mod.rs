@@ -1,12 +1,13 @@
 //! Scenario presets, one module per detector family, named like the family (the preset
 //! keeps the scene's name on the CLI): [`crpf`] holds `othr`, [`mht`] `sea-clutter`,
-//! [`phd`] `six-targets`. A preset is data: a struct holding the paper's values and the
+//! [`phd`] `six-targets`, [`cbmember`] `rotor-uav`, [`dp`] `dim-point`. A preset is data: a struct holding the paper's values and the
 //! documented choices for what the paper leaves open.
 
 use anyhow::{bail, Result};
 
 pub mod cbmember;
 pub mod crpf;
+pub mod dp;
 pub mod mht;
 pub mod phd;
 
@@ -14,6 +15,10 @@ pub mod phd;
 type Entry = (&'static str, &'static str, fn() -> serde_json::Value);
 
 const CATALOGUE: &[Entry] = &[(
+    "dim-point",
+    "DP-TBD (Wang, Zhang 2016): one sub-pixel point target in 128 x 128 Gaussian-noise images, 1 or 2 px/frame, SNR 1.6-2.5, 40 frames",
+    dp::DimPoint::describe,
+), (
     "rotor-uav",
     "CBMeMBer joint Doppler / micro-Doppler TBD (rotor-UAV paper, 2023): one rotor UAV, 256 x 512 range-Doppler maps, B = 2, 40 frames",
     cbmember::RotorUav::describe,

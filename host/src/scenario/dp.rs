@@ -1,0 +1,335 @@
+//! Scenario preset `dim-point` (Wang, Zhang 2016, §4): one point target, smaller than a
+//! pixel, in `128 x 128` intensity images of i.i.d. Gaussian noise, for the three DP-TBD
+//! recursions of `faint_core::detect::dp`.
+//!
+//! Values and choices (all also in [`DimPoint::describe`]):
+//! - **Image**: `128 x 128` pixels; pixel `(x, y)` = (column, row) of the row-major image
+//!   covers `[x, x+1) x [y, y+1)`. Noise `N(0, 1.5^2)` i.i.d. per pixel and frame.
+//! - **Target**: its whole amplitude `a` goes into the one pixel holding its continuous
+//!   position, `z = a + n` there; `SNR = a / sigma` (linear amplitude ratio, eq. 29),
+//!   swept 1.6 to 2.5.
+//! - **Motion**: straight and uniform at 1 or 2 px/frame; start uniform in
+//!   `[0, 128)^2`, heading uniform in `[0, 2 pi)`, redrawn (rejection) until the position
+//!   at the last frame is inside too (the path is a segment, so every frame is inside).
+//! - **Frames**: 40. **Run streams**: run `i` at speed `s` draws its truth and then its
+//!   frames, row-major, from `Rng::from_stream(derive_seed(seed, s), i)` whatever the SNR
+//!   (common random numbers across SNR and across the three methods); noise-only runs use
+//!   `derive_seed(seed, 1000 + s)` (threshold calibration) and `derive_seed(seed, 2000 + s)`
+//!   (the independent false-alarm check).
+//! - **Detectors** ([`DpConfig::dim_point`]): `q_B = 9` at 1 px/frame and 25 at 2 px/frame
+//!   (Arnold and the second order; Pulford uses the same `R_B`), `q_I = 9`, Gaussian
+//!   transition with `sigma_I = 0.5`, Pulford `P0 = speed^2 E`; merits kept over
+//!   `L = 40` frames, so the whole track is recovered.
+
+use anyhow::{anyhow, bail, ensure, Result};
+use faint_core::detect::dp::{
+    arnold_words, pulford_words, second_order_words, ArnoldDp, DpConfig, DpTrack, Method,
+    PulfordDp, SecondOrderDp,
+};
+use faint_core::rng::{derive_seed, Rng};
+use serde::Serialize;
+
+/// Image side `M` the host detectors are compiled for.
+pub const SIDE: usize = 128;
+/// Recoverable track length `L` (frames) of the host detectors: the whole run.
+pub const HISTORY: usize = 40;
+
+/// Arnold, `q_B = 9`.
+pub type Arnold9 = ArnoldDp<SIDE, 9, HISTORY, { arnold_words(SIDE, 9, HISTORY) }>;
+/// Arnold, `q_B = 25`.
+pub type Arnold25 = ArnoldDp<SIDE, 25, HISTORY, { arnold_words(SIDE, 25, HISTORY) }>;
+/// Pulford, `q_B = 9`.
+pub type Pulford9 = PulfordDp<SIDE, 9, HISTORY, { pulford_words(SIDE, 9, HISTORY) }>;
+/// Pulford, `q_B = 25`.
+pub type Pulford25 = PulfordDp<SIDE, 25, HISTORY, { pulford_words(SIDE, 25, HISTORY) }>;
+/// Second order, `q_B = 9`.
+pub type Second9 = SecondOrderDp<SIDE, 9, HISTORY, { second_order_words(SIDE, 9, HISTORY) }>;
+/// Second order, `q_B = 25`.
+pub type Second25 = SecondOrderDp<SIDE, 25, HISTORY, { second_order_words(SIDE, 25, HISTORY) }>;
+
+/// A configured DP detector built on the heap: zeroed in place (the `q_B = 25` second
+/// order is 6.2 MB, more than a thread's stack), then configured with `cfg`.
+pub fn boxed<D: DpTrack>(cfg: &DpConfig) -> Result<Box<D>> {
+    // SAFETY: every field of the three DP detectors is an integer, a float, a bool, a
+    // fieldless enum (discriminant 0 exists) or an array or struct of those, so all-zero
+    // bytes are a valid value: the core's documented zeroed-static construction (tested
+    // in tests/dp). `configure` then sets every field it reads.
+    let mut d: Box<D> = unsafe { Box::<D>::new_zeroed().assume_init() };
+    d.configure(cfg, 0).map_err(|e| anyhow!("{e}"))?;
+    Ok(d)
+}
+
+/// Runs `$body` with `$det: Box<_>` the host detector of `$method` and `$qb` (9 or 25),
+/// configured with `$cfg`; another `q_B` is an error naming it.
+macro_rules! with_dp {
+    ($method:expr, $qb:expr, $cfg:expr, |$det:ident| $body:expr) => {{
+        use faint_core::detect::dp::Method as M_;
+        use $crate::scenario::dp as sdp;
+        match ($method, $qb) {
+            (M_::Arnold, 9) => {
+                let $det = sdp::boxed::<sdp::Arnold9>($cfg)?;
+                $body
+            }
+            (M_::Arnold, 25) => {
+                let $det = sdp::boxed::<sdp::Arnold25>($cfg)?;
+                $body
+            }
+            (M_::Pulford, 9) => {
+                let $det = sdp::boxed::<sdp::Pulford9>($cfg)?;
+                $body
+            }
+            (M_::Pulford, 25) => {
+                let $det = sdp::boxed::<sdp::Pulford25>($cfg)?;
+                $body
+            }
+            (M_::SecondOrder, 9) => {
+                let $det = sdp::boxed::<sdp::Second9>($cfg)?;
+                $body
+            }
+            (M_::SecondOrder, 25) => {
+                let $det = sdp::boxed::<sdp::Second25>($cfg)?;
+                $body
+            }
+            (_, q) => anyhow::bail!("q_b = {q}: must be 9 or 25"),
+        }
+    }};
+}
+pub(crate) use with_dp;
+
+/// The three methods in the order of every table.
+pub const METHODS: [Method; 3] = [Method::Arnold, Method::Pulford, Method::SecondOrder];
+
+/// The preset.
+#[derive(Debug, Clone, Serialize)]
+pub struct DimPoint {
+    /// Image side (pixels).
+    pub side: usize,
+    /// Noise standard deviation `sigma`.
+    pub sigma: f32,
+    /// Frames per run.
+    pub frames: usize,
+    /// SNR grid of the paper's Fig. 6-7 (`a / sigma`, linear): `[from, to, step]`.
+    pub snr_grid: [f64; 3],
+    /// Target speeds (px/frame).
+    pub speeds: [u8; 2],
+    /// False-alarm probability of the detection thresholds.
+    pub pfa: f64,
+    /// Runs per point.
+    pub runs: usize,
+    /// Track-level detection: the best end within this Chebyshev distance (px) of the
+    /// true pixel.
+    pub near_px: usize,
+}
+
+impl Default for DimPoint {
+    fn default() -> Self {
+        Self {
+            side: SIDE,
+            sigma: 1.5,
+            frames: HISTORY,
+            snr_grid: [1.6, 2.5, 0.1],
+            speeds: [1, 2],
+            pfa: 0.01,
+            runs: 100,
+            near_px: 1,
+        }
+    }
+}
+
+/// A straight-line truth: the continuous position at frame `k` (0-based) is
+/// `start + k velocity` (pixel units).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Truth {
+    /// Continuous position at the first frame.
+    pub start: [f64; 2],
+    /// Velocity (px/frame).
+    pub velocity: [f64; 2],
+}
+
+impl Truth {
+    /// Continuous position at frame `k` (0-based).
+    pub fn position(&self, k: usize) -> [f64; 2] {
+        let t = k as f64;
+        [
+            self.start[0] + t * self.velocity[0],
+            self.start[1] + t * self.velocity[1],
+        ]
+    }
+
+    /// The pixel `(x, y)` holding the position at frame `k`.
+    pub fn pixel(&self, k: usize) -> (usize, usize) {
+        let p = self.position(k);
+        (p[0].floor() as usize, p[1].floor() as usize)
+    }
+}
+
+/// The `q_B` of a speed: 9 at 1 px/frame, 25 at 2 px/frame.
+pub fn qb_for(speed: u8) -> Result<usize> {
+    match speed {
+        1 => Ok(9),
+        2 => Ok(25),
+        s => bail!("speed {s} px/frame: the preset has 1 and 2"),
+    }
+}
+
+impl DimPoint {
+    /// The preset as JSON, with the detector configurations of both speeds.
+    pub fn describe() -> serde_json::Value {
+        let sc = Self::default();
+        let mut v = serde_json::to_value(&sc).unwrap_or_default();
+        let cfgs: Vec<serde_json::Value> = sc
+            .speeds
+            .iter()
+            .flat_map(|&s| {
+                METHODS.iter().map(move |&m| {
+                    serde_json::json!({
+                        "speed_px_per_frame": s,
+                        "q_b": qb_for(s).unwrap_or(0),
+                        "q_i": 9,
+                        "history_frames": HISTORY,
+                        "config": DpConfig::dim_point(m, s),
+                    })
+                })
+            })
+            .collect();
+        if let Some(o) = v.as_object_mut() {
+            o.insert("detectors".into(), serde_json::Value::Array(cfgs));
+            o.insert(
+                "motion".into(),
+                serde_json::json!("straight, uniform; start uniform in [0, 128)^2, heading uniform in [0, 2 pi), redrawn until the last position is inside"),
+            );
+            o.insert(
+                "target".into(),
+                serde_json::json!(
+                    "whole amplitude a = SNR sigma in the pixel holding the continuous position"
+                ),
+            );
+            o.insert(
+                "streams".into(),
+                serde_json::json!("run i at speed s: Rng::from_stream(derive_seed(seed, s), i); noise-only calibration derive_seed(seed, 1000 + s), check derive_seed(seed, 2000 + s)"),
+            );
+        }
+        v
+    }
+
+    /// Master seed of the target runs at `speed` (run `i` is stream `i`).
+    pub fn target_seed(seed: u64, speed: u8) -> u64 {
+        derive_seed(seed, u64::from(speed))
+    }
+
+    /// Master seed of the noise-only calibration runs at `speed`.
+    pub fn calibration_seed(seed: u64, speed: u8) -> u64 {
+        derive_seed(seed, 1000 + u64::from(speed))
+    }
+
+    /// Master seed of the independent noise-only check runs at `speed`.
+    pub fn check_seed(seed: u64, speed: u8) -> u64 {
+        derive_seed(seed, 2000 + u64::from(speed))
+    }
+
+    /// Draws a truth at `speed` px/frame that stays inside for all frames.
+    pub fn truth(&self, speed: f64, rng: &mut Rng) -> Result<Truth> {
+        let m = self.side as f64;
+        let last = self.frames.saturating_sub(1) as f64;
+        ensure!(
+            speed >= 0.0 && speed * last < m,
+            "speed {speed} px/frame: the target cannot stay inside for {} frames",
+            self.frames
+        );
+        for _ in 0..100_000 {
+            let start = [m * f64::from(rng.uniform()), m * f64::from(rng.uniform())];
+            let h = std::f64::consts::TAU * f64::from(rng.uniform());
+            let velocity = [speed * h.cos(), speed * h.sin()];
+            let t = Truth { start, velocity };
+            let end = t.position(self.frames.saturating_sub(1));
+            let inside = |v: f64| (0.0..m).contains(&v);
+            if inside(end[0]) && inside(end[1]) {
+                return Ok(t);
+            }
+        }
+        bail!("no truth inside the image after 100000 draws")
+    }
+
+    /// Frame `k` into `out` (`side^2` values, row-major): noise, plus `amp` at the
+    /// target's pixel when `truth` is given.
+    pub fn frame(
+        &self,
+        truth: Option<&Truth>,
+        amp: f32,
+        k: usize,
+        rng: &mut Rng,
+        out: &mut Vec<f32>,
+    ) {
+        out.clear();
+        out.extend((0..self.side * self.side).map(|_| self.sigma * rng.normal()));
+        if let Some(t) = truth {
+            let (x, y) = t.pixel(k);
+            if let Some(v) = out.get_mut(y * self.side + x) {
+                *v += amp;
+            }
+        }
+    }
+
+    /// One whole run: the truth (target runs) and every frame, from `rng` (see the module
+    /// docs for the stream). `snr = None` gives a noise-only run.
+    pub fn run(&self, snr: Option<f64>, speed: u8, rng: &mut Rng) -> Result<Run> {
+        let truth = match snr {
+            Some(_) => Some(self.truth(f64::from(speed), rng)?),
+            None => None,
+        };
+        let amp = (snr.unwrap_or(0.0) * f64::from(self.sigma)) as f32;
+        let mut frames = Vec::with_capacity(self.frames);
+        for k in 0..self.frames {
+            let mut f = Vec::new();
+            self.frame(truth.as_ref(), amp, k, rng, &mut f);
+            frames.push(f);
+        }
+        Ok(Run { truth, frames })
+    }
+}
+
+/// The frames of one run and its truth (`None`: noise only).
+#[derive(Debug, Clone)]
+pub struct Run {
+    /// The truth.
+    pub truth: Option<Truth>,
+    /// `frames x side^2` pixels.
+    pub frames: Vec<Vec<f32>>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn truths_stay_inside_and_move_at_the_speed() {
+        let sc = DimPoint::default();
+        let mut rng = Rng::seed_from_u64(3);
+        for speed in [1.0, 2.0] {
+            for _ in 0..200 {
+                let t = sc.truth(speed, &mut rng).unwrap();
+                let v = (t.velocity[0].powi(2) + t.velocity[1].powi(2)).sqrt();
+                assert!((v - speed).abs() < 1e-12);
+                for k in 0..sc.frames {
+                    let p = t.position(k);
+                    assert!(p.iter().all(|c| (0.0..128.0).contains(c)));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_target_pixel_holds_the_amplitude() {
+        let sc = DimPoint::default();
+        let mut a = sc.run(Some(2.0), 1, &mut Rng::seed_from_u64(5)).unwrap();
+        let b = sc.run(Some(0.0), 1, &mut Rng::seed_from_u64(5)).unwrap();
+        let t = a.truth.unwrap();
+        for k in 0..sc.frames {
+            let (x, y) = t.pixel(k);
+            let i = y * SIDE + x;
+            assert!((a.frames[k][i] - b.frames[k][i] - 3.0).abs() < 1e-5);
+            a.frames[k][i] = b.frames[k][i];
+            assert_eq!(a.frames[k], b.frames[k]);
+        }
+    }
+}
