@@ -457,15 +457,28 @@ impl Quant {
         Ok(true)
     }
 
+    /// The offset [`Quant::fast`] subtracts for merits re-centred by `sub`.
+    #[inline(always)]
+    pub(crate) const fn base(sub: i32) -> i32 {
+        MAGIC_BITS.wrapping_add(sub)
+    }
+
+    /// `round(z / lsb) - sub` of one pixel of a frame that needs no clamping (see
+    /// [`Quant::check`]), `base = Quant::base(sub)`.
+    #[inline(always)]
+    pub(crate) fn fast(&self, z: f32, base: i32) -> i32 {
+        ((z * self.inv_lsb + MAGIC).to_bits() as i32).wrapping_sub(base)
+    }
+
     /// Quantises one row into `out` as `q - sub`, returns the number of clamped pixels
     /// (`slow` = the frame needs the clamping path, see [`Quant::check`]).
     #[inline]
     pub(crate) fn row(&self, src: &[f32], sub: i32, slow: bool, out: &mut [i32]) -> u32 {
-        let base = MAGIC_BITS.wrapping_add(sub);
+        let base = Self::base(sub);
         let inv = self.inv_lsb;
         if !slow {
             for (o, &z) in out.iter_mut().zip(src) {
-                *o = ((z * inv + MAGIC).to_bits() as i32).wrapping_sub(base);
+                *o = self.fast(z, base);
             }
             return 0;
         }
@@ -624,6 +637,62 @@ impl Tally {
     #[inline]
     pub(crate) fn merit(&self, raw: i32, lsb: f32) -> f32 {
         (i64::from(raw) + self.offset) as f32 * lsb
+    }
+
+    /// Merit of a stored value, `None` before the first frame or without a value.
+    pub(crate) fn merit_of(&self, raw: Option<i32>, lsb: f32) -> Option<f32> {
+        if self.frames == 0 {
+            return None;
+        }
+        raw.map(|v| self.merit(v, lsb))
+    }
+
+    /// Ends a frame: stored merits were re-centred by `sub`; `best` at `xy` is the best.
+    pub(crate) fn advance(&mut self, sub: i32, best: i32, xy: (u16, u16), clamped: u32) {
+        self.offset += i64::from(sub);
+        self.best_raw = best;
+        self.best_xy = xy;
+        self.clamped = clamped;
+        self.frames = self.frames.wrapping_add(1);
+    }
+}
+
+/// The checks before a detector's recursion runs on `frame` (configured, length `m x m`,
+/// finite): whether the frame needs the clamping path ([`Quant::check`]).
+pub(crate) fn begin(configured: bool, quant: &Quant, frame: &[f32], m: usize) -> Result<bool> {
+    if !configured {
+        return Err(Error::InvalidConfig("unconfigured"));
+    }
+    check_len(frame, m)?;
+    quant.check(frame)
+}
+
+/// The report of the frame just run, after refilling `ends` (best merit at `raw(x, y)`).
+pub(crate) fn finish(
+    cfg: &DpConfig,
+    t: &Tally,
+    ends: &mut Ends,
+    m: usize,
+    raw: impl Fn(usize, usize) -> Option<i32>,
+) -> DpReport {
+    let lsb = cfg.lsb;
+    ends.fill(
+        m,
+        usize::from(cfg.top_k),
+        usize::from(cfg.separation),
+        t.best_xy,
+        t,
+        lsb,
+        |x, y| raw(x, y).unwrap_or(i32::MIN),
+    );
+    DpReport {
+        frame: t.frames,
+        best: TrackEnd {
+            x: t.best_xy.0,
+            y: t.best_xy.1,
+            merit: t.merit(t.best_raw, lsb),
+        },
+        clamped: t.clamped,
     }
 }
 

@@ -25,7 +25,7 @@
 //! `b = ceil(log2(q_B + 1))` (the window index or "restart").
 
 use super::{
-    bits_for, check_len, check_shape, detection, radius_of, read_bits, BitWriter, DpConfig,
+    begin, bits_for, check_shape, finish, detection, radius_of, read_bits, BitWriter, DpConfig,
     DpReport, DpTrack, Ends, MeritCell, Method, Quant, Tally, TrackEnd, MAGIC, MAGIC_BITS, STATE,
 };
 use crate::detect::{Detection, Detector, ScoreKind};
@@ -317,11 +317,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             }
             bw.finish();
         }
-        self.tally.offset += i64::from(sub);
-        self.tally.best_raw = best;
-        self.tally.best_xy = bxy;
-        self.tally.clamped = clamped;
-        self.tally.frames = k;
+        self.tally.advance(sub, best, bxy, clamped);
     }
 }
 
@@ -365,34 +361,12 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     }
 
     fn step(&mut self, frame: &[f32]) -> Result<DpReport> {
-        if !self.configured {
-            return Err(Error::InvalidConfig("unconfigured"));
-        }
-        check_len(frame, M)?;
-        let slow = self.quant.check(frame)?;
+        let slow = begin(self.configured, &self.quant, frame, M)?;
         self.run(frame, slow);
-        let t = self.tally;
-        let lsb = self.cfg.lsb;
         let mut ends = self.ends;
-        ends.fill(
-            M,
-            usize::from(self.cfg.top_k),
-            usize::from(self.cfg.separation),
-            t.best_xy,
-            &t,
-            lsb,
-            |x, y| self.raw(x, y).unwrap_or(i32::MIN),
-        );
+        let r = finish(&self.cfg, &self.tally, &mut ends, M, |x, y| self.raw(x, y));
         self.ends = ends;
-        Ok(DpReport {
-            frame: t.frames,
-            best: TrackEnd {
-                x: t.best_xy.0,
-                y: t.best_xy.1,
-                merit: t.merit(t.best_raw, lsb),
-            },
-            clamped: t.clamped,
-        })
+        Ok(r)
     }
 
     fn detection_count(&self) -> usize {
@@ -415,10 +389,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     }
 
     fn merit(&self, x: usize, y: usize) -> Option<f32> {
-        if self.tally.frames == 0 {
-            return None;
-        }
-        self.raw(x, y).map(|v| self.tally.merit(v, self.cfg.lsb))
+        self.tally.merit_of(self.raw(x, y), self.cfg.lsb)
     }
 
     /// Stops early at a restart (the track began there).

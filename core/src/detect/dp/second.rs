@@ -28,11 +28,11 @@
 //! 577 280 B (564 KiB); `C = i8` 147 456 + 5 760 + 512 + 270 336 = 424 064 B (414 KiB).
 
 use super::{
-    check_len, check_shape, detection, radius_of, read_bits, transition_table, BitWriter, DpConfig,
+    begin, check_shape, detection, finish, radius_of, read_bits, transition_table, BitWriter, DpConfig,
     DpReport, DpTrack, Ends, MeritCell, Method, Quant, Tally, TrackEnd, STATE,
 };
 use crate::detect::{Detection, Detector, ScoreKind};
-use crate::{Error, Result};
+use crate::Result;
 
 /// Largest supported `q_B` (5x5).
 pub(crate) const MAXQ: usize = 25;
@@ -142,6 +142,28 @@ pub(crate) const fn layout(qb: usize) -> Layout {
     l
 }
 
+/// Keys `[GX(-1..=1), GY(-1..=1)]` of a separable transition term
+/// `g(ex, ey) = gx(ex) + gy(ey)`: `GX = gx << 4 | (ex + 1)`, `GY = gy << 4 | (ey + 1) << 2`
+/// (`gx` the row `ey = 0`, `gy(ey) = g(0, ey) - g(0, 0)`); `None` if `g` is not separable
+/// (the Gaussian of eq. 16 is, up to the rounding of the table; the hard window is).
+pub(crate) fn separable(g: &[i32; 9]) -> Option<[i32; 6]> {
+    let gx = [g[3], g[4], g[5]];
+    let gy = [g[1] - g[4], 0, g[7] - g[4]];
+    for (i, &v) in g.iter().enumerate() {
+        if gx[i % 3] + gy[i / 3] != v {
+            return None;
+        }
+    }
+    Some([
+        gx[0] << 4,
+        (gx[1] << 4) | 1,
+        (gx[2] << 4) | 2,
+        gy[0] << 4,
+        (gy[1] << 4) | 4,
+        (gy[2] << 4) | 8,
+    ])
+}
+
 /// Bits of one pixel's pointer code for `q_B = qb` (0 if unsupported).
 pub(crate) const fn code_bits(qb: usize) -> u32 {
     layout(qb).bits
@@ -164,6 +186,8 @@ pub struct SecondOrderDp<
     tally: Tally,
     ends: Ends,
     g: [i32; 9],
+    /// `Some` keys `[GX(ex), GY(ey)]` when `g(e) = gx(ex) + gy(ey)` (see `separable`).
+    sep: Option<[i32; 6]>,
     s: [[[C; QB]; M]; M],
     jring: [[[C; QB]; M]; JROWS],
     zrow: [i32; M],
@@ -202,6 +226,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             tally: Tally::new(),
             ends: Ends::new(),
             g: [0; 9],
+            sep: None,
             s: [[[C::ZERO; QB]; M]; M],
             jring: [[[C::ZERO; QB]; M]; JROWS],
             zrow: [0; M],
@@ -254,6 +279,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         s: &[[[C; QB]; M]; M],
         jring: &mut [[[C; QB]; M]; JROWS],
         g: &[i32; 9],
+        sep: &Option<[i32; 6]>,
         rr: usize,
         plain: bool,
         bw: &mut Option<BitWriter<'_>>,
@@ -264,6 +290,10 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         };
         if plain {
             *dst = *src;
+            return;
+        }
+        if let Some(gk) = sep {
+            Self::j_row_sep(src, dst, gk, bw);
             return;
         }
         for (cell, out) in src.iter().zip(dst.iter_mut()) {
@@ -284,6 +314,68 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 if lay.chunk_last[d] {
                     if let Some(w) = bw.as_mut() {
                         w.push(acc, u32::from(lay.chunk_bits[d]));
+                    }
+                    acc = 0;
+                }
+            }
+        }
+    }
+
+    /// `J` of one row when `g` is separable: `J(d) = max_ey [GY(ey) + Hx(d - (0, ey), dx)]`,
+    /// `Hx(p_y, dx) = max_ex [I(p) << 4 + GX(ex)]` (row maxima shared by the states). The
+    /// keys carry `(ey + 1) << 2 | (ex + 1)`, ordered like the candidate index `j` (both
+    /// ascend in `e`), so the winner and its pointer are those of the plain 2-D max.
+    #[inline(always)]
+    fn j_row_sep(
+        src: &[[C; QB]; M],
+        dst: &mut [[C; QB]; M],
+        gk: &[i32; 6],
+        bw: &mut Option<BitWriter<'_>>,
+    ) {
+        let lay = &Self::LAY;
+        let (n, r) = (Self::N, Self::R);
+        let gk = *gk;
+        for (cell, out) in src.iter().zip(dst.iter_mut()) {
+            // hx[p_y][dx] over ex with p_x = dx - ex inside the window
+            let mut hx = [[FLOOR_KEY; 5]; 5];
+            for (pyi, hrow) in hx.iter_mut().enumerate().take(n) {
+                for (dxi, h) in hrow.iter_mut().enumerate().take(n) {
+                    let mut v = FLOOR_KEY;
+                    for (cx, &gx) in gk.iter().enumerate().take(3) {
+                        let pxi = (dxi + 1).wrapping_sub(cx);
+                        if pxi < n {
+                            let i = cell.get(pyi * n + pxi).map_or(C::FLOOR, |c| c.get());
+                            let key = (i << 4) + gx;
+                            v = if key > v { key } else { v };
+                        }
+                    }
+                    *h = v;
+                }
+            }
+            let mut acc = 0u32;
+            for (d, o) in out.iter_mut().enumerate() {
+                let (dyi, dxi) = (d / n, d % n);
+                let mut v = FLOOR_KEY;
+                for (cy, &gy) in gk.iter().skip(3).enumerate() {
+                    let pyi = (dyi + 1).wrapping_sub(cy);
+                    if pyi < n {
+                        let h = hx.get(pyi).and_then(|h| h.get(dxi)).map_or(FLOOR_KEY, |&h| h);
+                        let key = h + gy;
+                        v = if key > v { key } else { v };
+                    }
+                }
+                *o = C::sat(v >> 4);
+                // candidate index j = (cy - cy_min) n_x + (cx - cx_min)
+                let (cxmin, cymin) = ((dxi + 1).saturating_sub(2 * r), (dyi + 1).saturating_sub(2 * r));
+                let nx = (dxi + 1).min(2) + 1 - cxmin;
+                let cx = (v & 3) as usize;
+                let cy = ((v >> 2) & 3) as usize;
+                let j = (cy.wrapping_sub(cymin)).wrapping_mul(nx).wrapping_add(cx.wrapping_sub(cxmin));
+                let nd = u32::from(lay.nopt.get(d).copied().unwrap_or(1));
+                acc = acc.wrapping_mul(nd).wrapping_add(j as u32);
+                if lay.chunk_last.get(d).copied().unwrap_or(false) {
+                    if let Some(w) = bw.as_mut() {
+                        w.push(acc, u32::from(lay.chunk_bits.get(d).copied().unwrap_or(1)));
                     }
                     acc = 0;
                 }
@@ -325,6 +417,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 zrow,
                 quant,
                 g,
+                sep,
                 ..
             } = self;
             let words: &mut [u32] = if plain || Self::LP == 0 {
@@ -339,17 +432,19 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 Some(BitWriter::new(words))
             };
             for rr in 0..r.min(M) {
-                Self::j_row(states, jring, g, rr, plain, &mut bw);
+                Self::j_row(states, jring, g, sep, rr, plain, &mut bw);
             }
             for (y, src) in frame.chunks_exact(M).enumerate() {
                 if y + r < M {
-                    Self::j_row(states, jring, g, y + r, plain, &mut bw);
+                    Self::j_row(states, jring, g, sep, y + r, plain, &mut bw);
                 }
                 clamped += quant.row(src, sub, slow, zrow);
                 let Some(row) = states.get_mut(y) else {
                     continue;
                 };
-                for (x, (cell, &zq)) in row.iter_mut().zip(zrow.iter()).enumerate() {
+                let jring = &*jring;
+                // a pixel with clipped windows: every state checked
+                let edge = |x: usize, cell: &mut [C; QB], zq: i32, best: &mut i32, bx: &mut usize| {
                     for (s, c) in cell.iter_mut().enumerate() {
                         let (dx, dy) = (s % n, s / n);
                         let qx = (x + r).wrapping_sub(dx);
@@ -364,22 +459,54 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                             C::FLOOR
                         };
                         *c = C::sat(zq + j);
-                        if c.get() > best {
-                            best = c.get();
-                            bxy = (x as u16, y as u16);
+                        if c.get() > *best {
+                            *best = c.get();
+                            *bx = x;
                         }
                     }
+                };
+                let (mut rb, mut rx) = (i32::MIN, 0usize);
+                if y < r || y + r >= M {
+                    for (x, (cell, &zq)) in row.iter_mut().zip(zrow.iter()).enumerate() {
+                        edge(x, cell, zq, &mut rb, &mut rx);
+                    }
+                } else {
+                    // interior rows: the J rows of the states' predecessors t' = t - d
+                    let jr: [&[[C; QB]; M]; 5] = core::array::from_fn(|dy| {
+                        let qy = (y + r).wrapping_sub(dy.min(n - 1));
+                        &jring[qy % JROWS]
+                    });
+                    let lo = r.min(M);
+                    let hi = M.saturating_sub(r).max(lo);
+                    for (x, (cell, &zq)) in row.iter_mut().zip(zrow.iter()).enumerate() {
+                        if x < lo || x >= hi {
+                            edge(x, cell, zq, &mut rb, &mut rx);
+                            continue;
+                        }
+                        for (s, c) in cell.iter_mut().enumerate() {
+                            let (dx, dy) = (s % n, s / n);
+                            let j = jr[dy % 5]
+                                .get((x + r).wrapping_sub(dx))
+                                .and_then(|jc| jc.get(s))
+                                .map_or(C::FLOOR, |v| v.get());
+                            *c = C::sat(zq + j);
+                            if c.get() > rb {
+                                rb = c.get();
+                                rx = x;
+                            }
+                        }
+                    }
+                }
+                if rb > best {
+                    best = rb;
+                    bxy = (rx as u16, y as u16);
                 }
             }
             if let Some(w) = bw {
                 w.finish();
             }
         }
-        self.tally.offset += i64::from(sub);
-        self.tally.best_raw = best;
-        self.tally.best_xy = bxy;
-        self.tally.clamped = clamped;
-        self.tally.frames = k;
+        self.tally.advance(sub, best, bxy, clamped);
     }
 }
 
@@ -401,6 +528,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         self.cfg = *cfg;
         self.quant = quant;
         self.g = transition_table(cfg);
+        self.sep = separable(&self.g);
         self.configured = true;
         self.reset(0);
         Ok(())
@@ -416,34 +544,12 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     }
 
     fn step(&mut self, frame: &[f32]) -> Result<DpReport> {
-        if !self.configured {
-            return Err(Error::InvalidConfig("unconfigured"));
-        }
-        check_len(frame, M)?;
-        let slow = self.quant.check(frame)?;
+        let slow = begin(self.configured, &self.quant, frame, M)?;
         self.run(frame, slow);
-        let t = self.tally;
-        let lsb = self.cfg.lsb;
         let mut ends = self.ends;
-        ends.fill(
-            M,
-            usize::from(self.cfg.top_k),
-            usize::from(self.cfg.separation),
-            t.best_xy,
-            &t,
-            lsb,
-            |x, y| self.raw(x, y).unwrap_or(i32::MIN),
-        );
+        let r = finish(&self.cfg, &self.tally, &mut ends, M, |x, y| self.raw(x, y));
         self.ends = ends;
-        Ok(DpReport {
-            frame: t.frames,
-            best: TrackEnd {
-                x: t.best_xy.0,
-                y: t.best_xy.1,
-                merit: t.merit(t.best_raw, lsb),
-            },
-            clamped: t.clamped,
-        })
+        Ok(r)
     }
 
     fn detection_count(&self) -> usize {
@@ -466,10 +572,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     }
 
     fn merit(&self, x: usize, y: usize) -> Option<f32> {
-        if self.tally.frames == 0 {
-            return None;
-        }
-        self.raw(x, y).map(|v| self.tally.merit(v, self.cfg.lsb))
+        self.tally.merit_of(self.raw(x, y), self.cfg.lsb)
     }
 
     /// From the best state at `(x, y)` (ties: lowest state index).
