@@ -176,9 +176,17 @@ pub fn run() {
     let coarse = 0.25;
     // SAFETY (each `zeroed`): the type is one of the all-zero-checked types above.
     let det = unsafe { zeroed::<A9>(arena) };
-    rows("DP-TBD first order 3x3 i16, 128x128, L 8", det, arnold, image);
+    rows(
+        "DP-TBD first order 3x3 i16, 128x128, L 8",
+        det,
+        arnold,
+        image,
+    );
     let det = unsafe { zeroed::<A9i8>(arena) };
-    let cfg = DpConfig { lsb: coarse, ..arnold };
+    let cfg = DpConfig {
+        lsb: coarse,
+        ..arnold
+    };
     rows("DP-TBD first order 3x3 i8, 128x128, L 8", det, cfg, image);
     let det = unsafe { zeroed::<A25>(arena) };
     let cfg = DpConfig::dim_point(Method::Arnold, 2);
@@ -186,13 +194,23 @@ pub fn run() {
     let det = unsafe { zeroed::<P9>(arena) };
     rows("DP-TBD Pulford 3x3 i16, 128x128, L 8", det, pulford, image);
     let det = unsafe { zeroed::<S9>(arena) };
-    rows("DP-TBD second order 3x3/3x3 i16, 128x128, L 8", det, second, image);
+    rows(
+        "DP-TBD second order 3x3/3x3 i16, 128x128, L 8",
+        det,
+        second,
+        image,
+    );
     let det = unsafe { zeroed::<S9i8>(arena) };
     let cfg = DpConfig {
         lsb: coarse,
         ..second
     };
-    rows("DP-TBD second order 3x3/3x3 i8, 128x128, L 8", det, cfg, image);
+    rows(
+        "DP-TBD second order 3x3/3x3 i8, 128x128, L 8",
+        det,
+        cfg,
+        image,
+    );
     hprintln!(
         "DP-TBD statics (B): first order 3x3 i16 {}, i8 {}, 5x5 {}, Pulford 3x3 {}, second order i16 {}, i8 {}; shared arena {}, image {}",
         size_of::<A9>(),

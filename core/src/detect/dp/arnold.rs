@@ -13,12 +13,13 @@
 //! the winner is the back-pointer: 4 bits as is for `q_B = 9`, re-coded to the
 //! `ceil(log2 q_B)`-bit window index for larger windows.
 //!
-//! Memory: `M^2 sizeof(C)` merits, `9 M 4` bytes of row keys, `M 5` bytes of row
-//! buffers, and `4 W = (L - 1) ceil(M^2 b / 32) 4` bytes of back-pointers (`b = 4` for
-//! `q_B = 9`: 8 KiB per frame at `M = 128`).
+//! Memory ([`arnold_bytes`](super::arnold_bytes)): `M^2 sizeof(C)` merits, `9 M 4`
+//! bytes of row keys, `8 M` of row buffers, `4 W = (L - 1) ceil(M^2 b / 32) 4` bytes of
+//! back-pointers (`b = 4` for `q_B = 9`: 8 KiB per frame at `M = 128`) and the fixed
+//! fields: `M^2 c + 44 M + 4 W + 144` bytes.
 
 use super::{
-    begin, bits_for, check_shape, finish, detection, radius_of, read_bits, BitWriter, DpConfig,
+    begin, bits_for, check_shape, detection, finish, radius_of, read_bits, BitWriter, DpConfig,
     DpReport, DpTrack, Ends, MeritCell, Method, Quant, Tally, TrackEnd, STATE,
 };
 use crate::detect::{Detection, Detector, ScoreKind};
@@ -220,8 +221,9 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             });
             let mut acc = 0u64;
             for (i, (o, s)) in o8.iter_mut().zip(s8).enumerate() {
-                let mut v = FLOOR_KEY;
-                for h in h8.iter().take(n) {
+                // (the first row's key starts the max: every window holds a pixel)
+                let mut v = h8[0][i & 7];
+                for h in h8.iter().take(n).skip(1) {
                     let h = h[i & 7];
                     v = if h > v { h } else { v };
                 }
@@ -404,7 +406,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     }
 
     fn detection_count(&self) -> usize {
-        self.ends.n
+        self.ends.n as usize
     }
 
     fn detection(&self, i: usize) -> Option<Detection> {

@@ -370,6 +370,35 @@ pub const fn second_order_words(m: usize, qb: usize, l: usize) -> usize {
     words(m, second::code_bits(qb) as usize, l.saturating_sub(2))
 }
 
+/// Bytes of the fixed fields every DP detector carries (configuration, quantiser,
+/// running merit offset, reported ends), the same on 32- and 64-bit targets.
+pub const FIXED_BYTES: usize = 144;
+
+/// Static RAM (bytes) of an [`ArnoldDp<M, QB, L, W, C>`](ArnoldDp), `c = size_of::<C>()`:
+/// `M^2 c` merits + `44 M` row keys and buffers + `4 W` back-pointers + [`FIXED_BYTES`]
+/// (`M` a multiple of 4). `M = 128`, `q_B = 9`, `L = 8`: 95 888 B (`i16`), 79 504 B (`i8`).
+pub const fn arnold_bytes(m: usize, qb: usize, l: usize, c: usize) -> usize {
+    m * m * c + 44 * m + 4 * arnold_words(m, qb, l) + FIXED_BYTES
+}
+
+/// Static RAM (bytes) of a [`PulfordDp<M, QB, L, W, C>`](PulfordDp):
+/// `(M^2 + 4 M)(c + 24)` merits and Kalman filters (current and 4 delayed rows) + `5 M`
+/// row buffers + 264 B of gains + `4 W` back-pointers + [`FIXED_BYTES`] (`M` a multiple
+/// of 4). `M = 128`, `q_B = 9`, `L = 8`, `i16`: 497 688 B.
+pub const fn pulford_bytes(m: usize, qb: usize, l: usize, c: usize) -> usize {
+    (m * m + 4 * m) * (c + 24) + 5 * m + 264 + 4 * pulford_words(m, qb, l) + FIXED_BYTES
+}
+
+/// Static RAM (bytes) of a [`SecondOrderDp<M, QB, L, W, C>`](SecondOrderDp):
+/// `(M^2 + 5 M) q_B c` state merits and `J` rows + `4 M` row buffer + 64 B of transition
+/// keys + `4 W` back-pointers + [`FIXED_BYTES`] (`M` a multiple of 4). `M = 128`,
+/// `q_B = 9`, `L = 8`: 577 488 B (564 KiB) with `i16`, 424 272 B (414 KiB) with `i8`; the
+/// back-pointers are `(L - 2) 45 056` B, so within 512 KiB: `i16` merits up to `L = 6`
+/// (487 376 B), `i8` merits up to `L = 10` (514 384 B).
+pub const fn second_order_bytes(m: usize, qb: usize, l: usize, c: usize) -> usize {
+    (m * m + 5 * m) * qb * c + 4 * m + 64 + 4 * second_order_words(m, qb, l) + FIXED_BYTES
+}
+
 /// The second-order transition term `g(e)` in LSB for `e = (ex, ey)`, index
 /// `(ey + 1) * 3 + (ex + 1)`: `round(ln p(e) sigma^2 / (a_design lsb))` (Gaussian) or 0.
 pub fn transition_table(cfg: &DpConfig) -> [i32; 9] {
@@ -699,7 +728,8 @@ pub(crate) fn finish(
 /// The distinct track ends of the last frame, best first.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Ends {
-    pub(crate) n: usize,
+    /// Number of ends (`u32`, so the detectors' sizes are the same on 32- and 64-bit targets).
+    pub(crate) n: u32,
     pub(crate) ends: [TrackEnd; MAX_ENDS],
 }
 
@@ -716,7 +746,7 @@ impl Ends {
     }
 
     pub(crate) fn as_slice(&self) -> &[TrackEnd] {
-        self.ends.get(..self.n).unwrap_or(&[])
+        self.ends.get(..self.n as usize).unwrap_or(&[])
     }
 
     /// Fills the ends: the best (`best`), then up to `k - 1` more, each the best pixel
@@ -764,7 +794,7 @@ impl Ends {
             }
             n += 1;
         }
-        self.n = n;
+        self.n = n as u32;
         for (e, c) in self.ends.iter_mut().zip(chosen.iter().take(n)) {
             *e = TrackEnd {
                 x: c.0 as u16,

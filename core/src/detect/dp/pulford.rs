@@ -20,12 +20,13 @@
 //! (the paper: predecessors whose region excludes `t` "are no longer considered").
 //! Ties: the larger window index `(dy + R)(2R+1) + (dx + R)` wins.
 //!
-//! Memory: `M^2 (sizeof(C) + 24)` bytes of merits and filters, `4 M (sizeof(C) + 24)`
-//! of delayed rows, and `4 W = (L - 1) ceil(M^2 b / 32) 4` of back-pointers,
-//! `b = ceil(log2(q_B + 1))` (the window index or "restart").
+//! Memory ([`pulford_bytes`](super::pulford_bytes)): `M^2 (sizeof(C) + 24)` bytes of
+//! merits and filters, `4 M (sizeof(C) + 24)` of delayed rows, `5 M` of row buffers,
+//! 264 of gains, `4 W = (L - 1) ceil(M^2 b / 32) 4` of back-pointers,
+//! `b = ceil(log2(q_B + 1))` (the window index or "restart"), and 144 of fixed fields.
 
 use super::{
-    begin, bits_for, check_shape, finish, detection, radius_of, read_bits, BitWriter, DpConfig,
+    begin, bits_for, check_shape, detection, finish, radius_of, read_bits, BitWriter, DpConfig,
     DpReport, DpTrack, Ends, MeritCell, Method, Quant, Tally, TrackEnd, MAGIC, MAGIC_BITS, STATE,
 };
 use crate::detect::{Detection, Detector, ScoreKind};
@@ -370,7 +371,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     }
 
     fn detection_count(&self) -> usize {
-        self.ends.n
+        self.ends.n as usize
     }
 
     fn detection(&self, i: usize) -> Option<Detection> {

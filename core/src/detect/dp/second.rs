@@ -22,14 +22,16 @@
 //! `q_B = 9`: `n_d` is 9 in the centre, 6 on the edges, 4 in the corners; 70 bits in
 //! three chunks below 2^32 for `q_B = 25`), packed into a bit stream per frame.
 //!
-//! Memory: `M^2 q_B sizeof(C)` merits, `5 M q_B sizeof(C)` bytes of `J` rows,
-//! `4 M` of a row buffer, and `4 W = (L - 2) ceil(M^2 b / 32) 4` bytes of back-pointers.
-//! For `M = 128`, `q_B = 9`, `L = 8`: `C = i16` 294 912 + 11 520 + 512 + 270 336 =
-//! 577 280 B (564 KiB); `C = i8` 147 456 + 5 760 + 512 + 270 336 = 424 064 B (414 KiB).
+//! Memory ([`second_order_bytes`](super::second_order_bytes)): `M^2 q_B sizeof(C)`
+//! merits, `5 M q_B sizeof(C)` bytes of `J` rows, `4 M` of a row buffer, 64 of transition
+//! keys, `4 W = (L - 2) ceil(M^2 b / 32) 4` bytes of back-pointers and 144 of fixed
+//! fields. For `M = 128`, `q_B = 9`, `L = 8`: `C = i16` 294 912 + 11 520 + 512 + 64 +
+//! 270 336 + 144 = 577 488 B (564 KiB); `C = i8` 147 456 + 5 760 + 512 + 64 + 270 336 +
+//! 144 = 424 272 B (414 KiB, within 512 KiB).
 
 use super::{
-    begin, check_shape, detection, finish, radius_of, read_bits, transition_table, BitWriter, DpConfig,
-    DpReport, DpTrack, Ends, MeritCell, Method, Quant, Tally, TrackEnd, STATE,
+    begin, check_shape, detection, finish, radius_of, read_bits, transition_table, BitWriter,
+    DpConfig, DpReport, DpTrack, Ends, MeritCell, Method, Quant, Tally, TrackEnd, STATE,
 };
 use crate::detect::{Detection, Detector, ScoreKind};
 use crate::Result;
@@ -340,13 +342,15 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             let mut hx = [[FLOOR_KEY; 5]; 5];
             for (pyi, hrow) in hx.iter_mut().enumerate().take(n) {
                 for (dxi, h) in hrow.iter_mut().enumerate().take(n) {
-                    let mut v = FLOOR_KEY;
+                    // (`first`: the first candidate starts the max; constant once unrolled)
+                    let (mut v, mut first) = (FLOOR_KEY, true);
                     for (cx, &gx) in gk.iter().enumerate().take(3) {
                         let pxi = (dxi + 1).wrapping_sub(cx);
                         if pxi < n {
                             let i = cell.get(pyi * n + pxi).map_or(C::FLOOR, |c| c.get());
                             let key = (i << 4) + gx;
-                            v = if key > v { key } else { v };
+                            v = if first || key > v { key } else { v };
+                            first = false;
                         }
                     }
                     *h = v;
@@ -355,22 +359,31 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             let mut acc = 0u32;
             for (d, o) in out.iter_mut().enumerate() {
                 let (dyi, dxi) = (d / n, d % n);
-                let mut v = FLOOR_KEY;
+                let (mut v, mut first) = (FLOOR_KEY, true);
                 for (cy, &gy) in gk.iter().skip(3).enumerate() {
                     let pyi = (dyi + 1).wrapping_sub(cy);
                     if pyi < n {
-                        let h = hx.get(pyi).and_then(|h| h.get(dxi)).map_or(FLOOR_KEY, |&h| h);
+                        let h = hx
+                            .get(pyi)
+                            .and_then(|h| h.get(dxi))
+                            .map_or(FLOOR_KEY, |&h| h);
                         let key = h + gy;
-                        v = if key > v { key } else { v };
+                        v = if first || key > v { key } else { v };
+                        first = false;
                     }
                 }
                 *o = C::sat(v >> 4);
                 // candidate index j = (cy - cy_min) n_x + (cx - cx_min)
-                let (cxmin, cymin) = ((dxi + 1).saturating_sub(2 * r), (dyi + 1).saturating_sub(2 * r));
+                let (cxmin, cymin) = (
+                    (dxi + 1).saturating_sub(2 * r),
+                    (dyi + 1).saturating_sub(2 * r),
+                );
                 let nx = (dxi + 1).min(2) + 1 - cxmin;
                 let cx = (v & 3) as usize;
                 let cy = ((v >> 2) & 3) as usize;
-                let j = (cy.wrapping_sub(cymin)).wrapping_mul(nx).wrapping_add(cx.wrapping_sub(cxmin));
+                let j = (cy.wrapping_sub(cymin))
+                    .wrapping_mul(nx)
+                    .wrapping_add(cx.wrapping_sub(cxmin));
                 let nd = u32::from(lay.nopt.get(d).copied().unwrap_or(1));
                 acc = acc.wrapping_mul(nd).wrapping_add(j as u32);
                 if lay.chunk_last.get(d).copied().unwrap_or(false) {
@@ -444,27 +457,28 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 };
                 let jring = &*jring;
                 // a pixel with clipped windows: every state checked
-                let edge = |x: usize, cell: &mut [C; QB], zq: i32, best: &mut i32, bx: &mut usize| {
-                    for (s, c) in cell.iter_mut().enumerate() {
-                        let (dx, dy) = (s % n, s / n);
-                        let qx = (x + r).wrapping_sub(dx);
-                        let qy = (y + r).wrapping_sub(dy);
-                        let j = if qx < M && qy < M {
-                            jring
-                                .get(qy % JROWS)
-                                .and_then(|jr| jr.get(qx))
-                                .and_then(|jc| jc.get(s))
-                                .map_or(C::FLOOR, |v| v.get())
-                        } else {
-                            C::FLOOR
-                        };
-                        *c = C::sat(zq + j);
-                        if c.get() > *best {
-                            *best = c.get();
-                            *bx = x;
+                let edge =
+                    |x: usize, cell: &mut [C; QB], zq: i32, best: &mut i32, bx: &mut usize| {
+                        for (s, c) in cell.iter_mut().enumerate() {
+                            let (dx, dy) = (s % n, s / n);
+                            let qx = (x + r).wrapping_sub(dx);
+                            let qy = (y + r).wrapping_sub(dy);
+                            let j = if qx < M && qy < M {
+                                jring
+                                    .get(qy % JROWS)
+                                    .and_then(|jr| jr.get(qx))
+                                    .and_then(|jc| jc.get(s))
+                                    .map_or(C::FLOOR, |v| v.get())
+                            } else {
+                                C::FLOOR
+                            };
+                            *c = C::sat(zq + j);
+                            if c.get() > *best {
+                                *best = c.get();
+                                *bx = x;
+                            }
                         }
-                    }
-                };
+                    };
                 let (mut rb, mut rx) = (i32::MIN, 0usize);
                 if y < r || y + r >= M {
                     for (x, (cell, &zq)) in row.iter_mut().zip(zrow.iter()).enumerate() {
@@ -553,7 +567,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     }
 
     fn detection_count(&self) -> usize {
-        self.ends.n
+        self.ends.n as usize
     }
 
     fn detection(&self, i: usize) -> Option<Detection> {
