@@ -308,8 +308,10 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 // row y - R is no longer read: commit its new values
                 if y >= r {
                     let yc = y - r;
-                    self.merit[yc] = self.mring[yc & (DELAY - 1)];
-                    self.kf[yc] = self.kring[yc & (DELAY - 1)];
+                    if let (Some(m), Some(f)) = (self.merit.get_mut(yc), self.kf.get_mut(yc)) {
+                        *m = self.mring[yc & (DELAY - 1)];
+                        *f = self.kring[yc & (DELAY - 1)];
+                    }
                 }
             }
             for yc in M.saturating_sub(r)..M {

@@ -301,11 +301,13 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         for (cell, out) in src.iter().zip(dst.iter_mut()) {
             let mut acc = 0u32;
             for (d, o) in out.iter_mut().enumerate() {
-                let n = usize::from(lay.nopt[d]);
+                let n = usize::from(lay.nopt.get(d).copied().unwrap_or(0));
+                let (Some(oe), Some(os)) = (lay.opt_e.get(d), lay.opt_s.get(d)) else {
+                    continue;
+                };
                 let mut v = FLOOR_KEY;
-                for j in 0..n {
-                    let e = usize::from(lay.opt_e[d][j]);
-                    let p = usize::from(lay.opt_s[d][j]);
+                for (j, (&e, &p)) in oe.iter().zip(os.iter()).take(n).enumerate() {
+                    let (e, p) = (usize::from(e), usize::from(p));
                     let base = cell.get(p).map_or(C::FLOOR, |c| c.get());
                     let ge = g.get(e).copied().unwrap_or(0);
                     let key = ((base + ge) << 4) | j as i32;
@@ -313,9 +315,9 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 }
                 *o = C::sat(v >> 4);
                 acc = acc * n as u32 + (v & 15) as u32;
-                if lay.chunk_last[d] {
+                if lay.chunk_last.get(d).copied().unwrap_or(false) {
                     if let Some(w) = bw.as_mut() {
-                        w.push(acc, u32::from(lay.chunk_bits[d]));
+                        w.push(acc, u32::from(lay.chunk_bits.get(d).copied().unwrap_or(1)));
                     }
                     acc = 0;
                 }
@@ -460,9 +462,9 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 let edge =
                     |x: usize, cell: &mut [C; QB], zq: i32, best: &mut i32, bx: &mut usize| {
                         for (s, c) in cell.iter_mut().enumerate() {
-                            let (dx, dy) = (s % n, s / n);
-                            let qx = (x + r).wrapping_sub(dx);
-                            let qy = (y + r).wrapping_sub(dy);
+                            let (dx, dy) = (s % Self::N, s / Self::N);
+                            let qx = (x + Self::R).wrapping_sub(dx);
+                            let qy = (y + Self::R).wrapping_sub(dy);
                             let j = if qx < M && qy < M {
                                 jring
                                     .get(qy % JROWS)
@@ -625,10 +627,10 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 let slot = (f - 3) % Self::LP.max(1);
                 let pix = (slot * Self::WF) * 32 + (qy * M + qx) * Self::BITS;
                 let (cb, cbits, suf, nopt) = (
-                    usize::from(lay.chunk_bit[d]),
-                    u32::from(lay.chunk_bits[d]),
-                    lay.suffix[d].max(1),
-                    u32::from(lay.nopt[d]).max(1),
+                    usize::from(lay.chunk_bit.get(d).copied().unwrap_or(0)),
+                    u32::from(lay.chunk_bits.get(d).copied().unwrap_or(1)),
+                    lay.suffix.get(d).copied().unwrap_or(1).max(1),
+                    u32::from(lay.nopt.get(d).copied().unwrap_or(1)).max(1),
                 );
                 let code = read_bits(&self.ptr, pix + cb, cbits);
                 let jj = ((code / suf) % nopt) as usize;
