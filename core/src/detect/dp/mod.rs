@@ -376,27 +376,31 @@ pub const FIXED_BYTES: usize = 144;
 
 /// Static RAM (bytes) of an [`ArnoldDp<M, QB, L, W, C>`](ArnoldDp), `c = size_of::<C>()`:
 /// `M^2 c` merits + `44 M` row keys and buffers + `4 W` back-pointers + [`FIXED_BYTES`]
-/// (`M` a multiple of 4). `M = 128`, `q_B = 9`, `L = 8`: 95 888 B (`i16`), 79 504 B (`i8`).
+/// (`M` a multiple of 4), rounded up to a multiple of 8 (the alignment). `M = 128`,
+/// `q_B = 9`, `L = 8`: 95 888 B (`i16`), 79 504 B (`i8`).
 pub const fn arnold_bytes(m: usize, qb: usize, l: usize, c: usize) -> usize {
-    m * m * c + 44 * m + 4 * arnold_words(m, qb, l) + FIXED_BYTES
+    (m * m * c + 44 * m + 4 * arnold_words(m, qb, l) + FIXED_BYTES).next_multiple_of(8)
 }
 
 /// Static RAM (bytes) of a [`PulfordDp<M, QB, L, W, C>`](PulfordDp):
 /// `(M^2 + 4 M)(c + 24)` merits and Kalman filters (current and 4 delayed rows) + `5 M`
 /// row buffers + 264 B of gains + `4 W` back-pointers + [`FIXED_BYTES`] (`M` a multiple
-/// of 4). `M = 128`, `q_B = 9`, `L = 8`, `i16`: 497 688 B.
+/// of 4), rounded up to a multiple of 8. `M = 128`, `q_B = 9`, `L = 8`, `i16`: 497 688 B.
 pub const fn pulford_bytes(m: usize, qb: usize, l: usize, c: usize) -> usize {
-    (m * m + 4 * m) * (c + 24) + 5 * m + 264 + 4 * pulford_words(m, qb, l) + FIXED_BYTES
+    ((m * m + 4 * m) * (c + 24) + 5 * m + 264 + 4 * pulford_words(m, qb, l) + FIXED_BYTES)
+        .next_multiple_of(8)
 }
 
 /// Static RAM (bytes) of a [`SecondOrderDp<M, QB, L, W, C>`](SecondOrderDp):
 /// `(M^2 + 5 M) q_B c` state merits and `J` rows + `4 M` row buffer + 64 B of transition
-/// keys + `4 W` back-pointers + [`FIXED_BYTES`] (`M` a multiple of 4). `M = 128`,
+/// keys + `4 W` back-pointers + [`FIXED_BYTES`] (`M` a multiple of 4), rounded up to a
+/// multiple of 8. `M = 128`,
 /// `q_B = 9`, `L = 8`: 577 488 B (564 KiB) with `i16`, 424 272 B (414 KiB) with `i8`; the
 /// back-pointers are `(L - 2) 45 056` B, so within 512 KiB: `i16` merits up to `L = 6`
 /// (487 376 B), `i8` merits up to `L = 10` (514 384 B).
 pub const fn second_order_bytes(m: usize, qb: usize, l: usize, c: usize) -> usize {
-    (m * m + 5 * m) * qb * c + 4 * m + 64 + 4 * second_order_words(m, qb, l) + FIXED_BYTES
+    ((m * m + 5 * m) * qb * c + 4 * m + 64 + 4 * second_order_words(m, qb, l) + FIXED_BYTES)
+        .next_multiple_of(8)
 }
 
 /// The second-order transition term `g(e)` in LSB for `e = (ex, ey)`, index
