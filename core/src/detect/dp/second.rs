@@ -22,6 +22,12 @@
 //! `q_B = 9`: `n_d` is 9 in the centre, 6 on the edges, 4 in the corners; 70 bits in
 //! three chunks below 2^32 for `q_B = 25`), packed into a bit stream per frame.
 //!
+//! When the transition table is separable, `g(e) = gx(ex) + gy(ey)` (the preset's
+//! Gaussian after rounding, and the hard window), the max over the 9 candidates runs as
+//! row maxima shared by the states, then column maxima, on keys with the code
+//! `(ey + 1) << 2 | (ex + 1)`, which ascends with `j`: the same winners and pointers, 24
+//! compare-selects per pixel instead of 40. Otherwise the candidates are compared directly.
+//!
 //! Memory ([`second_order_bytes`](super::second_order_bytes)): `M^2 q_B sizeof(C)`
 //! merits, `5 M q_B sizeof(C)` bytes of `J` rows, `4 M` of a row buffer, 64 of transition
 //! keys, `4 W = (L - 2) ceil(M^2 b / 32) 4` bytes of back-pointers and 144 of fixed
