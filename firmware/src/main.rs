@@ -15,6 +15,7 @@ use cortex_m_semihosting::hprintln;
 
 mod cbmember;
 mod crpf;
+mod dp;
 mod harness;
 mod mht;
 mod phd;
@@ -34,6 +35,7 @@ fn main() -> ! {
     crpf::run();
     phd::run();
     cbmember::run();
+    dp::run();
     hprintln!();
     hprintln!(
         "static RAM of this image (.data + .bss, all rows): {} bytes",

@@ -122,9 +122,10 @@ fn brute_second(fr: &[Vec<f32>], m: usize, r: i64, g: &[i32; 9]) -> Vec<i64> {
 }
 
 fn merits<D: DpTrack>(d: &D) -> Vec<i64> {
-    (0..M * M)
+    let m = D::SIDE;
+    (0..m * m)
         .map(|i| {
-            let v = d.merit(i % M, i / M).unwrap();
+            let v = d.merit(i % m, i / m).unwrap();
             let l = (v / LSB).round();
             assert_eq!(l * LSB, v, "merit not a multiple of the LSB");
             l as i64
@@ -156,11 +157,44 @@ fn first_order_equals_exhaustive_search() {
     }
 }
 
+/// At `M = 16` the first order runs its 8-pixel blocks (at `M = 6` only the tail).
+#[test]
+fn first_order_equals_exhaustive_search_on_wider_frames() {
+    const W: usize = 16;
+    for seed in 0..3 {
+        let fr = frames(50 + seed, 4, W);
+        let mut a =
+            ArnoldDp::<W, 9, 4, { arnold_words(W, 9, 4) }>::new(cfg(Method::Arnold)).unwrap();
+        run_all(&mut a, &fr);
+        assert_eq!(merits(&a), brute_first(&fr, W, 1), "3x3 seed {seed}");
+        let mut b =
+            ArnoldDp::<W, 25, 4, { arnold_words(W, 25, 4) }>::new(cfg(Method::Arnold)).unwrap();
+        run_all(&mut b, &fr);
+        assert_eq!(merits(&b), brute_first(&fr, W, 2), "5x5 seed {seed}");
+        for i in 0..W * W {
+            let (x, y) = (i % W, i / W);
+            let mut t = [[0u16; 2]; 4];
+            assert_eq!(a.track(x, y, &mut t), 4);
+            let sum: i64 = (0..4)
+                .map(|j| q(fr[3 - j][t[j][1] as usize * W + t[j][0] as usize]))
+                .sum();
+            assert_eq!(sum, q(a.merit(x, y).unwrap()), "track at {x},{y}");
+        }
+    }
+}
+
 #[test]
 fn second_order_equals_exhaustive_search() {
-    for transition in [Transition::Gaussian, Transition::Hard] {
+    // sigma_I = 0.5 (the preset) and the hard window give separable tables (the fast
+    // row-maxima path), sigma_I = 0.7 does not (the general 2-D path).
+    for (transition, sigma_i) in [
+        (Transition::Gaussian, 0.5),
+        (Transition::Hard, 0.5),
+        (Transition::Gaussian, 0.7),
+    ] {
         let mut c = cfg(Method::SecondOrder);
         c.transition = transition;
+        c.sigma_i = sigma_i;
         let g = transition_table(&c);
         for seed in 0..4 {
             for n in 1..=4 {
@@ -573,4 +607,72 @@ proptest! {
         let mut s2 = S25::new(cfg(Method::SecondOrder)).unwrap();
         prop_assert_eq!(run_all(&mut s2, &fr), r1);
     }
+}
+
+/// Static RAM of each type equals its documented formula (`dp::*_bytes`), on 32-bit
+/// targets (the firmware prints the same sizes) and on this host.
+#[test]
+fn static_ram_equals_the_formulas() {
+    use faint::core::detect::dp::{arnold_bytes, pulford_bytes, second_order_bytes};
+    use std::mem::size_of;
+    macro_rules! check {
+        ($t:ident, $words:ident, $bytes:ident, $m:literal, $qb:literal, $l:literal, $c:ty) => {
+            assert_eq!(
+                size_of::<$t<$m, $qb, $l, { $words($m, $qb, $l) }, $c>>(),
+                $bytes($m, $qb, $l, size_of::<$c>()),
+                "{} M {} q_B {} L {} {}",
+                stringify!($t),
+                $m,
+                $qb,
+                $l,
+                stringify!($c)
+            );
+        };
+    }
+    check!(ArnoldDp, arnold_words, arnold_bytes, 128, 9, 8, i16);
+    check!(ArnoldDp, arnold_words, arnold_bytes, 128, 9, 8, i8);
+    check!(ArnoldDp, arnold_words, arnold_bytes, 128, 25, 8, i16);
+    check!(ArnoldDp, arnold_words, arnold_bytes, 12, 49, 3, i8);
+    check!(PulfordDp, pulford_words, pulford_bytes, 128, 9, 8, i16);
+    check!(PulfordDp, pulford_words, pulford_bytes, 16, 25, 5, i8);
+    check!(
+        SecondOrderDp,
+        second_order_words,
+        second_order_bytes,
+        128,
+        9,
+        8,
+        i16
+    );
+    check!(
+        SecondOrderDp,
+        second_order_words,
+        second_order_bytes,
+        128,
+        9,
+        8,
+        i8
+    );
+    check!(
+        SecondOrderDp,
+        second_order_words,
+        second_order_bytes,
+        20,
+        25,
+        4,
+        i16
+    );
+    check!(
+        SecondOrderDp,
+        second_order_words,
+        second_order_bytes,
+        12,
+        9,
+        2,
+        i8
+    );
+    // The goal: the 128 x 128 second order with L = 8 in at most 512 KiB (with i8 merits).
+    assert!(second_order_bytes(128, 9, 8, 1) <= 512 * 1024);
+    assert!(second_order_bytes(128, 9, 6, 2) <= 512 * 1024);
+    assert!(second_order_bytes(128, 9, 7, 2) > 512 * 1024);
 }

@@ -13,16 +13,17 @@
 //! the winner is the back-pointer: 4 bits as is for `q_B = 9`, re-coded to the
 //! `ceil(log2 q_B)`-bit window index for larger windows.
 //!
-//! Memory: `M^2 sizeof(C)` merits, `9 M 4` bytes of row keys, `M 5` bytes of row
-//! buffers, and `4 W = (L - 1) ceil(M^2 b / 32) 4` bytes of back-pointers (`b = 4` for
-//! `q_B = 9`: 8 KiB per frame at `M = 128`).
+//! Memory ([`arnold_bytes`](super::arnold_bytes)): `M^2 sizeof(C)` merits, `9 M 4`
+//! bytes of row keys, `8 M` of row buffers, `4 W = (L - 1) ceil(M^2 b / 32) 4` bytes of
+//! back-pointers (`b = 4` for `q_B = 9`: 8 KiB per frame at `M = 128`) and the fixed
+//! fields: `M^2 c + 44 M + 4 W + 144` bytes.
 
 use super::{
-    bits_for, check_len, check_shape, detection, radius_of, read_bits, BitWriter, DpConfig,
+    begin, bits_for, check_shape, detection, finish, radius_of, read_bits, BitWriter, DpConfig,
     DpReport, DpTrack, Ends, MeritCell, Method, Quant, Tally, TrackEnd, STATE,
 };
 use crate::detect::{Detection, Detector, ScoreKind};
-use crate::{Error, Result};
+use crate::Result;
 
 /// Bits of one back-pointer for a `q_B`-pixel window.
 pub(crate) const fn ptr_bits(qb: usize) -> u32 {
@@ -59,7 +60,6 @@ pub struct ArnoldDp<
     hring: [[i32; M]; RING + 1],
     kbuf: [i32; M],
     zrow: [i32; M],
-    codes: [u8; M],
     ptr: [u32; W],
 }
 
@@ -99,7 +99,6 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             hring: [[0; M]; RING + 1],
             kbuf: [0; M],
             zrow: [0; M],
-            codes: [0; M],
             ptr: [0; W],
         }
     }
@@ -117,6 +116,10 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     /// Row keys of merit row `r` into `dst` (max over the clipped row window).
     fn h_row(src: &[C; M], r: usize, dst: &mut [i32; M], kbuf: &mut [i32; M]) {
         let ycode = ((r & Self::PM) << Self::PB) as i32;
+        if Self::R == 1 {
+            Self::h_row3(src, ycode, dst);
+            return;
+        }
         for (x, (k, c)) in kbuf.iter_mut().zip(src.iter()).enumerate() {
             *k = (c.get() << Self::SH) | (x & Self::PM) as i32 | ycode;
         }
@@ -134,6 +137,144 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 *d = w.iter().copied().fold(FLOOR_KEY, i32::max);
             }
         }
+    }
+
+    /// The 3x3 row pass: `h(x) = max(p(x - 1), p(x))`, `p(x) = max(k(x), k(x + 1))`
+    /// (`k(-1) = k(M) = floor`), one pass, the keys built in registers (their code
+    /// repeats every 4 pixels).
+    #[inline]
+    fn h_row3(src: &[C; M], ycode: i32, dst: &mut [i32; M]) {
+        let key = |c: &C, x: i32| (c.get() << 4) | x | ycode;
+        let Some((first, rest)) = src.split_first() else {
+            return;
+        };
+        // k = k(x), pp = p(x - 1)
+        let mut k = key(first, 0);
+        let mut pp = k;
+        let mut step = |d: &mut i32, c: &C, xn: i32| {
+            let kn = key(c, xn);
+            let p = if kn > k { kn } else { k };
+            *d = if p > pp { p } else { pp };
+            pp = p;
+            k = kn;
+        };
+        let mut di = dst.chunks_exact_mut(4);
+        let mut si = rest.chunks_exact(4);
+        for (d, c) in di.by_ref().zip(si.by_ref()) {
+            if let ([d0, d1, d2, d3], [c1, c2, c3, c4]) = (d, c) {
+                step(d0, c1, 1);
+                step(d1, c2, 2);
+                step(d2, c3, 3);
+                step(d3, c4, 0);
+            }
+        }
+        // the last `(M - 1) % 4` pixels with a right neighbour, then the last pixel
+        let done = (M - 1) / 4 * 4;
+        let (dtail, stail) = (dst.get_mut(done..).unwrap_or(&mut []), si.remainder());
+        let mut x = done;
+        for (d, c) in dtail.iter_mut().zip(stail) {
+            x += 1;
+            step(d, c, (x & 3) as i32);
+        }
+        if let Some(d) = dst.last_mut() {
+            *d = if k > pp { k } else { pp };
+        }
+    }
+
+    /// The column pass of output row `y`: `v = max` over the `2R + 1` row keys, the new
+    /// merits `q + (v >> SH)` into `out`, the back-pointers into `bw`; returns the row's
+    /// best `(merit, x)` (ties: the first). `q(src[x])` is the quantised pixel.
+    #[inline(always)]
+    fn col_row<T>(
+        rows: &[&[i32; M]; 7],
+        src: &[T],
+        q: impl Fn(&T) -> i32,
+        y: usize,
+        out: &mut [C; M],
+        bw: &mut BitWriter<'_>,
+    ) -> (i32, usize) {
+        let n = 2 * Self::R + 1;
+        let mask = (1i32 << Self::SH) - 1;
+        let bits = Self::BITS;
+        let mut best = i32::MIN;
+        let mut bx = 0usize;
+        let one = |x: usize, v: i32, s: &T, o: &mut C, best: &mut i32, bx: &mut usize| {
+            let new = C::sat(q(s) + (v >> Self::SH));
+            *o = new;
+            let nv = new.get();
+            if nv > *best {
+                *best = nv;
+                *bx = x;
+            }
+            Self::code(v & mask, x, y)
+        };
+        let floor8 = [FLOOR_KEY; 8];
+        let mut x = 0usize;
+        let mut oi = out.chunks_exact_mut(8);
+        let mut si = src.chunks_exact(8);
+        for (o8, s8) in oi.by_ref().zip(si.by_ref()) {
+            let h8: [&[i32; 8]; 7] = core::array::from_fn(|j| {
+                rows[j]
+                    .get(x..x + 8)
+                    .and_then(|h| <&[i32; 8]>::try_from(h).ok())
+                    .unwrap_or(&floor8)
+            });
+            let mut acc = 0u64;
+            for (i, (o, s)) in o8.iter_mut().zip(s8).enumerate() {
+                // (the first row's key starts the max: every window holds a pixel)
+                let mut v = h8[0][i & 7];
+                for h in h8.iter().take(n).skip(1) {
+                    let h = h[i & 7];
+                    v = if h > v { h } else { v };
+                }
+                let c = one(x + i, v, s, o, &mut best, &mut bx);
+                acc |= u64::from(c) << (bits as usize * i);
+            }
+            if Self::LP > 0 {
+                bw.push(acc as u32, 32);
+                if bits > 4 {
+                    bw.push((acc >> 32) as u32, 8 * bits - 32);
+                }
+            }
+            x += 8;
+        }
+        for (o, s) in oi.into_remainder().iter_mut().zip(si.remainder()) {
+            let mut v = FLOOR_KEY;
+            for rw in rows.iter().take(n) {
+                let h = rw.get(x).copied().unwrap_or(FLOOR_KEY);
+                v = if h > v { h } else { v };
+            }
+            let c = one(x, v, s, o, &mut best, &mut bx);
+            if Self::LP > 0 {
+                bw.push(c, bits);
+            }
+            x += 1;
+        }
+        (best, bx)
+    }
+
+    /// The back-pointer of the winning key code `code` (low `SH` bits) at `(x, y)`: as is
+    /// for `q_B = 9`, else the window index `(dy + R)(2R + 1) + (dx + R)`.
+    #[inline(always)]
+    fn code(code: i32, x: usize, y: usize) -> u32 {
+        if Self::R == 1 {
+            return code as u32;
+        }
+        let r = Self::R as i32;
+        let pm = Self::PM as i32;
+        let cx = code & pm;
+        let cy = code >> Self::PB;
+        let half = 1 << (Self::PB - 1);
+        let wrap = |c: i32, p: usize| {
+            let d = (c - (p as i32 & pm)) & pm;
+            if d >= half {
+                d - (pm + 1)
+            } else {
+                d
+            }
+        };
+        let n = 2 * r + 1;
+        ((wrap(cx, x) + r) + n * (wrap(cy, y) + r)) as u32
     }
 
     /// Predecessor of pixel `(x, y)` from its back-pointer `code`.
@@ -187,13 +328,12 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 .get_mut(slot * Self::WF..(slot + 1) * Self::WF)
                 .unwrap_or(&mut []);
             let mut bw = BitWriter::new(words);
-            let mask = (1i32 << Self::SH) - 1;
+            let base = Quant::base(sub);
             for (y, src) in frame.chunks_exact(M).enumerate() {
                 if y + r < M {
                     let (src, dst) = (&self.merit[y + r], &mut self.hring[(y + r) & (RING - 1)]);
                     Self::h_row(src, y + r, dst, &mut self.kbuf);
                 }
-                clamped += self.quant.row(src, sub, slow, &mut self.zrow);
                 let rows: [&[i32; M]; 7] = core::array::from_fn(|j| {
                     let yy = (y + j) as isize - r as isize;
                     if j < 2 * r + 1 && yy >= 0 && (yy as usize) < M {
@@ -202,52 +342,24 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                         &self.hring[RING]
                     }
                 });
-                let row = &mut self.merit[y];
-                for x in 0..M {
-                    let mut v = FLOOR_KEY;
-                    for rw in rows.iter().take(2 * r + 1) {
-                        v = v.max(rw[x]);
-                    }
-                    let new = C::sat(self.zrow[x] + (v >> Self::SH));
-                    row[x] = new;
-                    let nv = new.get();
-                    if nv > best {
-                        best = nv;
-                        bxy = (x as u16, y as u16);
-                    }
-                    let code = v & mask;
-                    self.codes[x] = if r == 1 {
-                        code as u8
-                    } else {
-                        let pm = Self::PM as i32;
-                        let cx = code & pm;
-                        let cy = code >> Self::PB;
-                        let half = 1 << (Self::PB - 1);
-                        let wrap = |c: i32, p: usize| {
-                            let d = (c - (p as i32 & pm)) & pm;
-                            if d >= half {
-                                d - (pm + 1)
-                            } else {
-                                d
-                            }
-                        };
-                        let n = (2 * r + 1) as i32;
-                        ((wrap(cx, x) + r as i32) + n * (wrap(cy, y) + r as i32)) as u8
-                    };
-                }
-                if Self::LP > 0 {
-                    for &c in self.codes.iter() {
-                        bw.push(u32::from(c), Self::BITS);
-                    }
+                let Some(row) = self.merit.get_mut(y) else {
+                    continue;
+                };
+                let (rb, rx) = if slow {
+                    clamped += self.quant.row(src, sub, true, &mut self.zrow);
+                    Self::col_row(&rows, &self.zrow, |&q| q, y, row, &mut bw)
+                } else {
+                    let quant = self.quant;
+                    Self::col_row(&rows, src, |&z| quant.fast(z, base), y, row, &mut bw)
+                };
+                if rb > best {
+                    best = rb;
+                    bxy = (rx as u16, y as u16);
                 }
             }
             bw.finish();
         }
-        self.tally.offset += i64::from(sub);
-        self.tally.best_raw = best;
-        self.tally.best_xy = bxy;
-        self.tally.clamped = clamped;
-        self.tally.frames = k;
+        self.tally.advance(sub, best, bxy, clamped);
     }
 }
 
@@ -285,38 +397,16 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
 
     /// One `M x M` frame, row-major.
     fn step(&mut self, frame: &[f32]) -> Result<DpReport> {
-        if !self.configured {
-            return Err(Error::InvalidConfig("unconfigured"));
-        }
-        check_len(frame, M)?;
-        let slow = self.quant.check(frame)?;
+        let slow = begin(self.configured, &self.quant, frame, M)?;
         self.run(frame, slow);
-        let t = self.tally;
-        let lsb = self.cfg.lsb;
         let mut ends = self.ends;
-        ends.fill(
-            M,
-            usize::from(self.cfg.top_k),
-            usize::from(self.cfg.separation),
-            t.best_xy,
-            &t,
-            lsb,
-            |x, y| self.raw(x, y).unwrap_or(i32::MIN),
-        );
+        let r = finish(&self.cfg, &self.tally, &mut ends, M, |x, y| self.raw(x, y));
         self.ends = ends;
-        Ok(DpReport {
-            frame: t.frames,
-            best: TrackEnd {
-                x: t.best_xy.0,
-                y: t.best_xy.1,
-                merit: t.merit(t.best_raw, lsb),
-            },
-            clamped: t.clamped,
-        })
+        Ok(r)
     }
 
     fn detection_count(&self) -> usize {
-        self.ends.n
+        self.ends.n as usize
     }
 
     fn detection(&self, i: usize) -> Option<Detection> {
@@ -335,10 +425,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     }
 
     fn merit(&self, x: usize, y: usize) -> Option<f32> {
-        if self.tally.frames == 0 {
-            return None;
-        }
-        self.raw(x, y).map(|v| self.tally.merit(v, self.cfg.lsb))
+        self.tally.merit_of(self.raw(x, y), self.cfg.lsb)
     }
 
     fn track(&self, x: usize, y: usize, out: &mut [[u16; 2]]) -> usize {

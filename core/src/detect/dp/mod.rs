@@ -370,6 +370,39 @@ pub const fn second_order_words(m: usize, qb: usize, l: usize) -> usize {
     words(m, second::code_bits(qb) as usize, l.saturating_sub(2))
 }
 
+/// Bytes of the fixed fields every DP detector carries (configuration, quantiser,
+/// running merit offset, reported ends), the same on 32- and 64-bit targets.
+pub const FIXED_BYTES: usize = 144;
+
+/// Static RAM (bytes) of an [`ArnoldDp<M, QB, L, W, C>`](ArnoldDp), `c = size_of::<C>()`:
+/// `M^2 c` merits + `44 M` row keys and buffers + `4 W` back-pointers + [`FIXED_BYTES`]
+/// (`M` a multiple of 4), rounded up to a multiple of 8 (the alignment). `M = 128`,
+/// `q_B = 9`, `L = 8`: 95 888 B (`i16`), 79 504 B (`i8`).
+pub const fn arnold_bytes(m: usize, qb: usize, l: usize, c: usize) -> usize {
+    (m * m * c + 44 * m + 4 * arnold_words(m, qb, l) + FIXED_BYTES).next_multiple_of(8)
+}
+
+/// Static RAM (bytes) of a [`PulfordDp<M, QB, L, W, C>`](PulfordDp):
+/// `(M^2 + 4 M)(c + 24)` merits and Kalman filters (current and 4 delayed rows) + `5 M`
+/// row buffers + 264 B of gains + `4 W` back-pointers + [`FIXED_BYTES`] (`M` a multiple
+/// of 4), rounded up to a multiple of 8. `M = 128`, `q_B = 9`, `L = 8`, `i16`: 497 688 B.
+pub const fn pulford_bytes(m: usize, qb: usize, l: usize, c: usize) -> usize {
+    ((m * m + 4 * m) * (c + 24) + 5 * m + 264 + 4 * pulford_words(m, qb, l) + FIXED_BYTES)
+        .next_multiple_of(8)
+}
+
+/// Static RAM (bytes) of a [`SecondOrderDp<M, QB, L, W, C>`](SecondOrderDp):
+/// `(M^2 + 5 M) q_B c` state merits and `J` rows + `4 M` row buffer + 64 B of transition
+/// keys + `4 W` back-pointers + [`FIXED_BYTES`] (`M` a multiple of 4), rounded up to a
+/// multiple of 8. `M = 128`,
+/// `q_B = 9`, `L = 8`: 577 488 B (564 KiB) with `i16`, 424 272 B (414 KiB) with `i8`; the
+/// back-pointers are `(L - 2) 45 056` B, so within 512 KiB: `i16` merits up to `L = 6`
+/// (487 376 B), `i8` merits up to `L = 10` (514 384 B).
+pub const fn second_order_bytes(m: usize, qb: usize, l: usize, c: usize) -> usize {
+    ((m * m + 5 * m) * qb * c + 4 * m + 64 + 4 * second_order_words(m, qb, l) + FIXED_BYTES)
+        .next_multiple_of(8)
+}
+
 /// The second-order transition term `g(e)` in LSB for `e = (ex, ey)`, index
 /// `(ey + 1) * 3 + (ex + 1)`: `round(ln p(e) sigma^2 / (a_design lsb))` (Gaussian) or 0.
 pub fn transition_table(cfg: &DpConfig) -> [i32; 9] {
@@ -457,15 +490,28 @@ impl Quant {
         Ok(true)
     }
 
+    /// The offset [`Quant::fast`] subtracts for merits re-centred by `sub`.
+    #[inline(always)]
+    pub(crate) const fn base(sub: i32) -> i32 {
+        MAGIC_BITS.wrapping_add(sub)
+    }
+
+    /// `round(z / lsb) - sub` of one pixel of a frame that needs no clamping (see
+    /// [`Quant::check`]), `base = Quant::base(sub)`.
+    #[inline(always)]
+    pub(crate) fn fast(&self, z: f32, base: i32) -> i32 {
+        ((z * self.inv_lsb + MAGIC).to_bits() as i32).wrapping_sub(base)
+    }
+
     /// Quantises one row into `out` as `q - sub`, returns the number of clamped pixels
     /// (`slow` = the frame needs the clamping path, see [`Quant::check`]).
     #[inline]
     pub(crate) fn row(&self, src: &[f32], sub: i32, slow: bool, out: &mut [i32]) -> u32 {
-        let base = MAGIC_BITS.wrapping_add(sub);
+        let base = Self::base(sub);
         let inv = self.inv_lsb;
         if !slow {
             for (o, &z) in out.iter_mut().zip(src) {
-                *o = ((z * inv + MAGIC).to_bits() as i32).wrapping_sub(base);
+                *o = self.fast(z, base);
             }
             return 0;
         }
@@ -625,12 +671,69 @@ impl Tally {
     pub(crate) fn merit(&self, raw: i32, lsb: f32) -> f32 {
         (i64::from(raw) + self.offset) as f32 * lsb
     }
+
+    /// Merit of a stored value, `None` before the first frame or without a value.
+    pub(crate) fn merit_of(&self, raw: Option<i32>, lsb: f32) -> Option<f32> {
+        if self.frames == 0 {
+            return None;
+        }
+        raw.map(|v| self.merit(v, lsb))
+    }
+
+    /// Ends a frame: stored merits were re-centred by `sub`; `best` at `xy` is the best.
+    pub(crate) fn advance(&mut self, sub: i32, best: i32, xy: (u16, u16), clamped: u32) {
+        self.offset += i64::from(sub);
+        self.best_raw = best;
+        self.best_xy = xy;
+        self.clamped = clamped;
+        self.frames = self.frames.wrapping_add(1);
+    }
+}
+
+/// The checks before a detector's recursion runs on `frame` (configured, length `m x m`,
+/// finite): whether the frame needs the clamping path ([`Quant::check`]).
+pub(crate) fn begin(configured: bool, quant: &Quant, frame: &[f32], m: usize) -> Result<bool> {
+    if !configured {
+        return Err(Error::InvalidConfig("unconfigured"));
+    }
+    check_len(frame, m)?;
+    quant.check(frame)
+}
+
+/// The report of the frame just run, after refilling `ends` (best merit at `raw(x, y)`).
+pub(crate) fn finish(
+    cfg: &DpConfig,
+    t: &Tally,
+    ends: &mut Ends,
+    m: usize,
+    raw: impl Fn(usize, usize) -> Option<i32>,
+) -> DpReport {
+    let lsb = cfg.lsb;
+    ends.fill(
+        m,
+        usize::from(cfg.top_k),
+        usize::from(cfg.separation),
+        t.best_xy,
+        t,
+        lsb,
+        |x, y| raw(x, y).unwrap_or(i32::MIN),
+    );
+    DpReport {
+        frame: t.frames,
+        best: TrackEnd {
+            x: t.best_xy.0,
+            y: t.best_xy.1,
+            merit: t.merit(t.best_raw, lsb),
+        },
+        clamped: t.clamped,
+    }
 }
 
 /// The distinct track ends of the last frame, best first.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Ends {
-    pub(crate) n: usize,
+    /// Number of ends (`u32`, so the detectors' sizes are the same on 32- and 64-bit targets).
+    pub(crate) n: u32,
     pub(crate) ends: [TrackEnd; MAX_ENDS],
 }
 
@@ -647,7 +750,7 @@ impl Ends {
     }
 
     pub(crate) fn as_slice(&self) -> &[TrackEnd] {
-        self.ends.get(..self.n).unwrap_or(&[])
+        self.ends.get(..self.n as usize).unwrap_or(&[])
     }
 
     /// Fills the ends: the best (`best`), then up to `k - 1` more, each the best pixel
@@ -695,7 +798,7 @@ impl Ends {
             }
             n += 1;
         }
-        self.n = n;
+        self.n = n as u32;
         for (e, c) in self.ends.iter_mut().zip(chosen.iter().take(n)) {
             *e = TrackEnd {
                 x: c.0 as u16,

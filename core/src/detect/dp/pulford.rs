@@ -20,12 +20,13 @@
 //! (the paper: predecessors whose region excludes `t` "are no longer considered").
 //! Ties: the larger window index `(dy + R)(2R+1) + (dx + R)` wins.
 //!
-//! Memory: `M^2 (sizeof(C) + 24)` bytes of merits and filters, `4 M (sizeof(C) + 24)`
-//! of delayed rows, and `4 W = (L - 1) ceil(M^2 b / 32) 4` of back-pointers,
-//! `b = ceil(log2(q_B + 1))` (the window index or "restart").
+//! Memory ([`pulford_bytes`](super::pulford_bytes)): `M^2 (sizeof(C) + 24)` bytes of
+//! merits and filters, `4 M (sizeof(C) + 24)` of delayed rows, `5 M` of row buffers,
+//! 264 of gains, `4 W = (L - 1) ceil(M^2 b / 32) 4` of back-pointers,
+//! `b = ceil(log2(q_B + 1))` (the window index or "restart"), and 144 of fixed fields.
 
 use super::{
-    bits_for, check_len, check_shape, detection, radius_of, read_bits, BitWriter, DpConfig,
+    begin, bits_for, check_shape, detection, finish, radius_of, read_bits, BitWriter, DpConfig,
     DpReport, DpTrack, Ends, MeritCell, Method, Quant, Tally, TrackEnd, MAGIC, MAGIC_BITS, STATE,
 };
 use crate::detect::{Detection, Detector, ScoreKind};
@@ -307,8 +308,10 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 // row y - R is no longer read: commit its new values
                 if y >= r {
                     let yc = y - r;
-                    self.merit[yc] = self.mring[yc & (DELAY - 1)];
-                    self.kf[yc] = self.kring[yc & (DELAY - 1)];
+                    if let (Some(m), Some(f)) = (self.merit.get_mut(yc), self.kf.get_mut(yc)) {
+                        *m = self.mring[yc & (DELAY - 1)];
+                        *f = self.kring[yc & (DELAY - 1)];
+                    }
                 }
             }
             for yc in M.saturating_sub(r)..M {
@@ -317,11 +320,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             }
             bw.finish();
         }
-        self.tally.offset += i64::from(sub);
-        self.tally.best_raw = best;
-        self.tally.best_xy = bxy;
-        self.tally.clamped = clamped;
-        self.tally.frames = k;
+        self.tally.advance(sub, best, bxy, clamped);
     }
 }
 
@@ -365,38 +364,16 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     }
 
     fn step(&mut self, frame: &[f32]) -> Result<DpReport> {
-        if !self.configured {
-            return Err(Error::InvalidConfig("unconfigured"));
-        }
-        check_len(frame, M)?;
-        let slow = self.quant.check(frame)?;
+        let slow = begin(self.configured, &self.quant, frame, M)?;
         self.run(frame, slow);
-        let t = self.tally;
-        let lsb = self.cfg.lsb;
         let mut ends = self.ends;
-        ends.fill(
-            M,
-            usize::from(self.cfg.top_k),
-            usize::from(self.cfg.separation),
-            t.best_xy,
-            &t,
-            lsb,
-            |x, y| self.raw(x, y).unwrap_or(i32::MIN),
-        );
+        let r = finish(&self.cfg, &self.tally, &mut ends, M, |x, y| self.raw(x, y));
         self.ends = ends;
-        Ok(DpReport {
-            frame: t.frames,
-            best: TrackEnd {
-                x: t.best_xy.0,
-                y: t.best_xy.1,
-                merit: t.merit(t.best_raw, lsb),
-            },
-            clamped: t.clamped,
-        })
+        Ok(r)
     }
 
     fn detection_count(&self) -> usize {
-        self.ends.n
+        self.ends.n as usize
     }
 
     fn detection(&self, i: usize) -> Option<Detection> {
@@ -415,10 +392,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     }
 
     fn merit(&self, x: usize, y: usize) -> Option<f32> {
-        if self.tally.frames == 0 {
-            return None;
-        }
-        self.raw(x, y).map(|v| self.tally.merit(v, self.cfg.lsb))
+        self.tally.merit_of(self.raw(x, y), self.cfg.lsb)
     }
 
     /// Stops early at a restart (the track began there).

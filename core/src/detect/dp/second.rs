@@ -22,17 +22,25 @@
 //! `q_B = 9`: `n_d` is 9 in the centre, 6 on the edges, 4 in the corners; 70 bits in
 //! three chunks below 2^32 for `q_B = 25`), packed into a bit stream per frame.
 //!
-//! Memory: `M^2 q_B sizeof(C)` merits, `5 M q_B sizeof(C)` bytes of `J` rows,
-//! `4 M` of a row buffer, and `4 W = (L - 2) ceil(M^2 b / 32) 4` bytes of back-pointers.
-//! For `M = 128`, `q_B = 9`, `L = 8`: `C = i16` 294 912 + 11 520 + 512 + 270 336 =
-//! 577 280 B (564 KiB); `C = i8` 147 456 + 5 760 + 512 + 270 336 = 424 064 B (414 KiB).
+//! When the transition table is separable, `g(e) = gx(ex) + gy(ey)` (the preset's
+//! Gaussian after rounding, and the hard window), the max over the 9 candidates runs as
+//! row maxima shared by the states, then column maxima, on keys with the code
+//! `(ey + 1) << 2 | (ex + 1)`, which ascends with `j`: the same winners and pointers, 24
+//! compare-selects per pixel instead of 40. Otherwise the candidates are compared directly.
+//!
+//! Memory ([`second_order_bytes`](super::second_order_bytes)): `M^2 q_B sizeof(C)`
+//! merits, `5 M q_B sizeof(C)` bytes of `J` rows, `4 M` of a row buffer, 64 of transition
+//! keys, `4 W = (L - 2) ceil(M^2 b / 32) 4` bytes of back-pointers and 144 of fixed
+//! fields. For `M = 128`, `q_B = 9`, `L = 8`: `C = i16` 294 912 + 11 520 + 512 + 64 +
+//! 270 336 + 144 = 577 488 B (564 KiB); `C = i8` 147 456 + 5 760 + 512 + 64 + 270 336 +
+//! 144 = 424 272 B (414 KiB, within 512 KiB).
 
 use super::{
-    check_len, check_shape, detection, radius_of, read_bits, transition_table, BitWriter, DpConfig,
-    DpReport, DpTrack, Ends, MeritCell, Method, Quant, Tally, TrackEnd, STATE,
+    begin, check_shape, detection, finish, radius_of, read_bits, transition_table, BitWriter,
+    DpConfig, DpReport, DpTrack, Ends, MeritCell, Method, Quant, Tally, TrackEnd, STATE,
 };
 use crate::detect::{Detection, Detector, ScoreKind};
-use crate::{Error, Result};
+use crate::Result;
 
 /// Largest supported `q_B` (5x5).
 pub(crate) const MAXQ: usize = 25;
@@ -142,6 +150,28 @@ pub(crate) const fn layout(qb: usize) -> Layout {
     l
 }
 
+/// Keys `[GX(-1..=1), GY(-1..=1)]` of a separable transition term
+/// `g(ex, ey) = gx(ex) + gy(ey)`: `GX = gx << 4 | (ex + 1)`, `GY = gy << 4 | (ey + 1) << 2`
+/// (`gx` the row `ey = 0`, `gy(ey) = g(0, ey) - g(0, 0)`); `None` if `g` is not separable
+/// (the Gaussian of eq. 16 is, up to the rounding of the table; the hard window is).
+pub(crate) fn separable(g: &[i32; 9]) -> Option<[i32; 6]> {
+    let gx = [g[3], g[4], g[5]];
+    let gy = [g[1] - g[4], 0, g[7] - g[4]];
+    for (i, &v) in g.iter().enumerate() {
+        if gx[i % 3] + gy[i / 3] != v {
+            return None;
+        }
+    }
+    Some([
+        gx[0] << 4,
+        (gx[1] << 4) | 1,
+        (gx[2] << 4) | 2,
+        gy[0] << 4,
+        (gy[1] << 4) | 4,
+        (gy[2] << 4) | 8,
+    ])
+}
+
 /// Bits of one pixel's pointer code for `q_B = qb` (0 if unsupported).
 pub(crate) const fn code_bits(qb: usize) -> u32 {
     layout(qb).bits
@@ -164,6 +194,8 @@ pub struct SecondOrderDp<
     tally: Tally,
     ends: Ends,
     g: [i32; 9],
+    /// `Some` keys `[GX(ex), GY(ey)]` when `g(e) = gx(ex) + gy(ey)` (see `separable`).
+    sep: Option<[i32; 6]>,
     s: [[[C; QB]; M]; M],
     jring: [[[C; QB]; M]; JROWS],
     zrow: [i32; M],
@@ -202,6 +234,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             tally: Tally::new(),
             ends: Ends::new(),
             g: [0; 9],
+            sep: None,
             s: [[[C::ZERO; QB]; M]; M],
             jring: [[[C::ZERO; QB]; M]; JROWS],
             zrow: [0; M],
@@ -254,6 +287,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         s: &[[[C; QB]; M]; M],
         jring: &mut [[[C; QB]; M]; JROWS],
         g: &[i32; 9],
+        sep: &Option<[i32; 6]>,
         rr: usize,
         plain: bool,
         bw: &mut Option<BitWriter<'_>>,
@@ -266,14 +300,20 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             *dst = *src;
             return;
         }
+        if let Some(gk) = sep {
+            Self::j_row_sep(src, dst, gk, bw);
+            return;
+        }
         for (cell, out) in src.iter().zip(dst.iter_mut()) {
             let mut acc = 0u32;
             for (d, o) in out.iter_mut().enumerate() {
-                let n = usize::from(lay.nopt[d]);
+                let n = usize::from(lay.nopt.get(d).copied().unwrap_or(0));
+                let (Some(oe), Some(os)) = (lay.opt_e.get(d), lay.opt_s.get(d)) else {
+                    continue;
+                };
                 let mut v = FLOOR_KEY;
-                for j in 0..n {
-                    let e = usize::from(lay.opt_e[d][j]);
-                    let p = usize::from(lay.opt_s[d][j]);
+                for (j, (&e, &p)) in oe.iter().zip(os.iter()).take(n).enumerate() {
+                    let (e, p) = (usize::from(e), usize::from(p));
                     let base = cell.get(p).map_or(C::FLOOR, |c| c.get());
                     let ge = g.get(e).copied().unwrap_or(0);
                     let key = ((base + ge) << 4) | j as i32;
@@ -281,9 +321,82 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 }
                 *o = C::sat(v >> 4);
                 acc = acc * n as u32 + (v & 15) as u32;
-                if lay.chunk_last[d] {
+                if lay.chunk_last.get(d).copied().unwrap_or(false) {
                     if let Some(w) = bw.as_mut() {
-                        w.push(acc, u32::from(lay.chunk_bits[d]));
+                        w.push(acc, u32::from(lay.chunk_bits.get(d).copied().unwrap_or(1)));
+                    }
+                    acc = 0;
+                }
+            }
+        }
+    }
+
+    /// `J` of one row when `g` is separable: `J(d) = max_ey [GY(ey) + Hx(d - (0, ey), dx)]`,
+    /// `Hx(p_y, dx) = max_ex [I(p) << 4 + GX(ex)]` (row maxima shared by the states). The
+    /// keys carry `(ey + 1) << 2 | (ex + 1)`, ordered like the candidate index `j` (both
+    /// ascend in `e`), so the winner and its pointer are those of the plain 2-D max.
+    #[inline(always)]
+    fn j_row_sep(
+        src: &[[C; QB]; M],
+        dst: &mut [[C; QB]; M],
+        gk: &[i32; 6],
+        bw: &mut Option<BitWriter<'_>>,
+    ) {
+        let lay = &Self::LAY;
+        let (n, r) = (Self::N, Self::R);
+        let gk = *gk;
+        for (cell, out) in src.iter().zip(dst.iter_mut()) {
+            // hx[p_y][dx] over ex with p_x = dx - ex inside the window
+            let mut hx = [[FLOOR_KEY; 5]; 5];
+            for (pyi, hrow) in hx.iter_mut().enumerate().take(n) {
+                for (dxi, h) in hrow.iter_mut().enumerate().take(n) {
+                    // (`first`: the first candidate starts the max; constant once unrolled)
+                    let (mut v, mut first) = (FLOOR_KEY, true);
+                    for (cx, &gx) in gk.iter().enumerate().take(3) {
+                        let pxi = (dxi + 1).wrapping_sub(cx);
+                        if pxi < n {
+                            let i = cell.get(pyi * n + pxi).map_or(C::FLOOR, |c| c.get());
+                            let key = (i << 4) + gx;
+                            v = if first || key > v { key } else { v };
+                            first = false;
+                        }
+                    }
+                    *h = v;
+                }
+            }
+            let mut acc = 0u32;
+            for (d, o) in out.iter_mut().enumerate() {
+                let (dyi, dxi) = (d / n, d % n);
+                let (mut v, mut first) = (FLOOR_KEY, true);
+                for (cy, &gy) in gk.iter().skip(3).enumerate() {
+                    let pyi = (dyi + 1).wrapping_sub(cy);
+                    if pyi < n {
+                        let h = hx
+                            .get(pyi)
+                            .and_then(|h| h.get(dxi))
+                            .map_or(FLOOR_KEY, |&h| h);
+                        let key = h + gy;
+                        v = if first || key > v { key } else { v };
+                        first = false;
+                    }
+                }
+                *o = C::sat(v >> 4);
+                // candidate index j = (cy - cy_min) n_x + (cx - cx_min)
+                let (cxmin, cymin) = (
+                    (dxi + 1).saturating_sub(2 * r),
+                    (dyi + 1).saturating_sub(2 * r),
+                );
+                let nx = (dxi + 1).min(2) + 1 - cxmin;
+                let cx = (v & 3) as usize;
+                let cy = ((v >> 2) & 3) as usize;
+                let j = (cy.wrapping_sub(cymin))
+                    .wrapping_mul(nx)
+                    .wrapping_add(cx.wrapping_sub(cxmin));
+                let nd = u32::from(lay.nopt.get(d).copied().unwrap_or(1));
+                acc = acc.wrapping_mul(nd).wrapping_add(j as u32);
+                if lay.chunk_last.get(d).copied().unwrap_or(false) {
+                    if let Some(w) = bw.as_mut() {
+                        w.push(acc, u32::from(lay.chunk_bits.get(d).copied().unwrap_or(1)));
                     }
                     acc = 0;
                 }
@@ -325,6 +438,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 zrow,
                 quant,
                 g,
+                sep,
                 ..
             } = self;
             let words: &mut [u32] = if plain || Self::LP == 0 {
@@ -339,47 +453,82 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 Some(BitWriter::new(words))
             };
             for rr in 0..r.min(M) {
-                Self::j_row(states, jring, g, rr, plain, &mut bw);
+                Self::j_row(states, jring, g, sep, rr, plain, &mut bw);
             }
             for (y, src) in frame.chunks_exact(M).enumerate() {
                 if y + r < M {
-                    Self::j_row(states, jring, g, y + r, plain, &mut bw);
+                    Self::j_row(states, jring, g, sep, y + r, plain, &mut bw);
                 }
                 clamped += quant.row(src, sub, slow, zrow);
                 let Some(row) = states.get_mut(y) else {
                     continue;
                 };
-                for (x, (cell, &zq)) in row.iter_mut().zip(zrow.iter()).enumerate() {
-                    for (s, c) in cell.iter_mut().enumerate() {
-                        let (dx, dy) = (s % n, s / n);
-                        let qx = (x + r).wrapping_sub(dx);
-                        let qy = (y + r).wrapping_sub(dy);
-                        let j = if qx < M && qy < M {
-                            jring
-                                .get(qy % JROWS)
-                                .and_then(|jr| jr.get(qx))
+                let jring = &*jring;
+                // a pixel with clipped windows: every state checked
+                let edge =
+                    |x: usize, cell: &mut [C; QB], zq: i32, best: &mut i32, bx: &mut usize| {
+                        for (s, c) in cell.iter_mut().enumerate() {
+                            let (dx, dy) = (s % Self::N, s / Self::N);
+                            let qx = (x + Self::R).wrapping_sub(dx);
+                            let qy = (y + Self::R).wrapping_sub(dy);
+                            let j = if qx < M && qy < M {
+                                jring
+                                    .get(qy % JROWS)
+                                    .and_then(|jr| jr.get(qx))
+                                    .and_then(|jc| jc.get(s))
+                                    .map_or(C::FLOOR, |v| v.get())
+                            } else {
+                                C::FLOOR
+                            };
+                            *c = C::sat(zq + j);
+                            if c.get() > *best {
+                                *best = c.get();
+                                *bx = x;
+                            }
+                        }
+                    };
+                let (mut rb, mut rx) = (i32::MIN, 0usize);
+                if y < r || y + r >= M {
+                    for (x, (cell, &zq)) in row.iter_mut().zip(zrow.iter()).enumerate() {
+                        edge(x, cell, zq, &mut rb, &mut rx);
+                    }
+                } else {
+                    // interior rows: the J rows of the states' predecessors t' = t - d
+                    let jr: [&[[C; QB]; M]; 5] = core::array::from_fn(|dy| {
+                        let qy = (y + r).wrapping_sub(dy.min(n - 1));
+                        &jring[qy % JROWS]
+                    });
+                    let lo = r.min(M);
+                    let hi = M.saturating_sub(r).max(lo);
+                    for (x, (cell, &zq)) in row.iter_mut().zip(zrow.iter()).enumerate() {
+                        if x < lo || x >= hi {
+                            edge(x, cell, zq, &mut rb, &mut rx);
+                            continue;
+                        }
+                        for (s, c) in cell.iter_mut().enumerate() {
+                            let (dx, dy) = (s % n, s / n);
+                            let j = jr[dy % 5]
+                                .get((x + r).wrapping_sub(dx))
                                 .and_then(|jc| jc.get(s))
-                                .map_or(C::FLOOR, |v| v.get())
-                        } else {
-                            C::FLOOR
-                        };
-                        *c = C::sat(zq + j);
-                        if c.get() > best {
-                            best = c.get();
-                            bxy = (x as u16, y as u16);
+                                .map_or(C::FLOOR, |v| v.get());
+                            *c = C::sat(zq + j);
+                            if c.get() > rb {
+                                rb = c.get();
+                                rx = x;
+                            }
                         }
                     }
+                }
+                if rb > best {
+                    best = rb;
+                    bxy = (rx as u16, y as u16);
                 }
             }
             if let Some(w) = bw {
                 w.finish();
             }
         }
-        self.tally.offset += i64::from(sub);
-        self.tally.best_raw = best;
-        self.tally.best_xy = bxy;
-        self.tally.clamped = clamped;
-        self.tally.frames = k;
+        self.tally.advance(sub, best, bxy, clamped);
     }
 }
 
@@ -401,6 +550,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         self.cfg = *cfg;
         self.quant = quant;
         self.g = transition_table(cfg);
+        self.sep = separable(&self.g);
         self.configured = true;
         self.reset(0);
         Ok(())
@@ -416,38 +566,16 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     }
 
     fn step(&mut self, frame: &[f32]) -> Result<DpReport> {
-        if !self.configured {
-            return Err(Error::InvalidConfig("unconfigured"));
-        }
-        check_len(frame, M)?;
-        let slow = self.quant.check(frame)?;
+        let slow = begin(self.configured, &self.quant, frame, M)?;
         self.run(frame, slow);
-        let t = self.tally;
-        let lsb = self.cfg.lsb;
         let mut ends = self.ends;
-        ends.fill(
-            M,
-            usize::from(self.cfg.top_k),
-            usize::from(self.cfg.separation),
-            t.best_xy,
-            &t,
-            lsb,
-            |x, y| self.raw(x, y).unwrap_or(i32::MIN),
-        );
+        let r = finish(&self.cfg, &self.tally, &mut ends, M, |x, y| self.raw(x, y));
         self.ends = ends;
-        Ok(DpReport {
-            frame: t.frames,
-            best: TrackEnd {
-                x: t.best_xy.0,
-                y: t.best_xy.1,
-                merit: t.merit(t.best_raw, lsb),
-            },
-            clamped: t.clamped,
-        })
+        Ok(r)
     }
 
     fn detection_count(&self) -> usize {
-        self.ends.n
+        self.ends.n as usize
     }
 
     fn detection(&self, i: usize) -> Option<Detection> {
@@ -466,10 +594,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     }
 
     fn merit(&self, x: usize, y: usize) -> Option<f32> {
-        if self.tally.frames == 0 {
-            return None;
-        }
-        self.raw(x, y).map(|v| self.tally.merit(v, self.cfg.lsb))
+        self.tally.merit_of(self.raw(x, y), self.cfg.lsb)
     }
 
     /// From the best state at `(x, y)` (ties: lowest state index).
@@ -508,10 +633,10 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 let slot = (f - 3) % Self::LP.max(1);
                 let pix = (slot * Self::WF) * 32 + (qy * M + qx) * Self::BITS;
                 let (cb, cbits, suf, nopt) = (
-                    usize::from(lay.chunk_bit[d]),
-                    u32::from(lay.chunk_bits[d]),
-                    lay.suffix[d].max(1),
-                    u32::from(lay.nopt[d]).max(1),
+                    usize::from(lay.chunk_bit.get(d).copied().unwrap_or(0)),
+                    u32::from(lay.chunk_bits.get(d).copied().unwrap_or(1)),
+                    lay.suffix.get(d).copied().unwrap_or(1).max(1),
+                    u32::from(lay.nopt.get(d).copied().unwrap_or(1)).max(1),
                 );
                 let code = read_bits(&self.ptr, pix + cb, cbits);
                 let jj = ((code / suf) % nopt) as usize;
