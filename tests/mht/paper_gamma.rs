@@ -7,6 +7,7 @@
 //!   [0, 1]), or `exp(-mu (1 - sqrt(q1)))` (re-derived); it enters the threshold through
 //!   the targets' crossing term `m1` of eq. 22;
 //! - the level of `Pfa`: whole grid (eq. 28) or one cell (eq. 27).
+//!
 //! The thresholds are pinned: a change of the model code shows here.
 
 use faint::host::analysis::mht::{p_ch, CellModel, ModelParams};
