@@ -32,13 +32,7 @@ fn instrumented_stage3_equals_the_detector() {
                 assert_eq!(a.c.to_bits(), b.c.to_bits());
             }
             for (_, f) in &fates {
-                let k = match f {
-                    Fate::Confirmed => 0,
-                    Fate::Short => 1,
-                    Fate::Merged => 2,
-                    Fate::Residual => 3,
-                };
-                fates_seen[k] = true;
+                fates_seen[f.index()] = true;
             }
         }
     }

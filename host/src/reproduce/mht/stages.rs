@@ -43,6 +43,18 @@ pub enum Fate {
     Residual,
 }
 
+impl Fate {
+    /// Position in `StageReport::peak_fates` (`Confirmed`, `Short`, `Merged`, `Residual`).
+    pub fn index(self) -> usize {
+        match self {
+            Fate::Confirmed => 0,
+            Fate::Short => 1,
+            Fate::Merged => 2,
+            Fate::Residual => 3,
+        }
+    }
+}
+
 /// Stage 3 of `m`'s completed period at `gamma1`: every peak's recovered track and fate.
 /// The confirmed ones equal `m.tracks()` when `gamma1` is `m`'s `gamma_1`.
 pub fn stage3_fates(m: &Mht, gamma1: u8) -> Vec<(Track<NS>, Fate)> {
@@ -239,13 +251,7 @@ impl StageReport {
         let fates = stage3_fates(m, gamma1);
         self.trials += 1;
         for (_, f) in &fates {
-            let k = match f {
-                Fate::Confirmed => 0,
-                Fate::Short => 1,
-                Fate::Merged => 2,
-                Fate::Residual => 3,
-            };
-            self.peak_fates[k] += 1;
+            self.peak_fates[f.index()] += 1;
         }
         let confirmed: Vec<&Track<NS>> = fates
             .iter()
