@@ -11,6 +11,16 @@
 //! the plots that belong to targets and to other confirmed tracks, and the peak cell's
 //! count without the plots it shares with the other confirmed tracks; `noresid` turns the detector's
 //! residual rule (`MhtConfig::residual`) off.
+//!
+//! Stage attribution (`reproduce::mht::attribute`): `mht_diag stages LAMBDA TRIALS GAMMA1 [SEED]`
+//! prints, for scenes `Rng::from_stream(SEED, t)` (default 5151), the stage at which each
+//! lost target was stopped and what each false track is made of.
+//!
+//! Fig. 4 (near-optimal detector): `mht_diag fig4 N M LAMBDA TRIALS NULL` evaluates the
+//! paper's law at `N` scans, window `M`, and simulates MHT-TBD with that `N`, `M` at the
+//! law's `gamma_1` for grid Pfa 1e-4: Pd over `TRIALS` scenes with 5 targets
+//! (`Rng::from_stream(6161, t)`), and the share of `NULL` clutter-only periods
+//! (`Rng::from_stream(6262, t)`) whose largest cell reaches it / that confirm a track.
 use faint_core::detect::Detector;
 use faint_core::rng::Rng;
 use faint_host::analysis::mht::{CellModel, ChainSource, CompoundModel};
@@ -227,10 +237,106 @@ fn lost_targets(a: &[String]) {
     println!("lost {lost}");
 }
 
+fn fig4(a: &[String]) {
+    use faint_host::reproduce::mht::{evaluate_trial, proportion_ci};
+    let arg = |i: usize, d: f64| a.get(i).and_then(|s| s.parse().ok()).unwrap_or(d);
+    let (n, mw, lambda) = (arg(2, 20.0) as usize, arg(3, 7.0) as usize, arg(4, 300.0));
+    let (trials, null) = (arg(5, 200.0) as u64, arg(6, 200.0) as u64);
+    let mut mp = model_params(&SeaClutter::paper(lambda as f32));
+    mp.n = n;
+    mp.m = mw;
+    let cm = CellModel::new(mp);
+    let g = cm.gamma_for_pfa(1e-4);
+    println!(
+        "paper law N {n} M {mw} lambda {lambda}: p_ch {:.4} p_dh {:.4} gamma_1 {g} grid Pfa {:.3e} model Pd {:.4}",
+        cm.p_ch,
+        cm.p_dh,
+        cm.pfa_grid(g),
+        cm.pd(g)
+    );
+    let mut sc = SeaClutter::paper(lambda as f32);
+    sc.n_scans = n;
+    let build = || {
+        let (mut m, c) = detectors(&sc, g.min(255) as u8, n as u8).ok()?;
+        let mut cfg = *m.config();
+        cfg.m = mw;
+        m.configure(&cfg, 0).ok()?;
+        Some((m, c))
+    };
+    let Some((mut m, mut c)) = build() else {
+        eprintln!("bad configuration");
+        return;
+    };
+    let (mut det, mut fa) = (0u64, 0u64);
+    for t in 0..trials {
+        let tr = sc.generate(&mut Rng::from_stream(6161, t));
+        let st = evaluate_trial(&sc, &tr, &mut m, &mut c);
+        det += u64::from(st.mht_detected);
+        fa += u64::from(st.mht_false);
+    }
+    let nt = trials * sc.n_targets as u64;
+    let (p, lo, hi) = proportion_ci(det, nt);
+    println!("simulated Pd {p:.4} [{lo:.4}, {hi:.4}] ({det} of {nt}), false tracks {fa} in {trials} scenes");
+    sc.n_targets = 0;
+    let (mut cell, mut conf) = (0u64, 0u64);
+    for t in 0..null {
+        let tr = sc.generate(&mut Rng::from_stream(6262, t));
+        let st = evaluate_trial(&sc, &tr, &mut m, &mut c);
+        cell += u64::from(usize::from(st.mht_max_count) >= g);
+        conf += u64::from(st.mht_false > 0);
+    }
+    let (p, lo, hi) = proportion_ci(cell, null);
+    let (q, qlo, qhi) = proportion_ci(conf, null);
+    println!(
+        "clutter-only periods: largest cell >= gamma_1 {p:.4} [{lo:.4}, {hi:.4}] ({cell} of {null}); with a confirmed track {q:.4} [{qlo:.4}, {qhi:.4}] ({conf})"
+    );
+}
+
+fn stages(a: &[String]) {
+    let lambda: f32 = a.get(2).and_then(|s| s.parse().ok()).unwrap_or(398.0);
+    let trials: u64 = a.get(3).and_then(|s| s.parse().ok()).unwrap_or(200);
+    let g1: u8 = a.get(4).and_then(|s| s.parse().ok()).unwrap_or(21);
+    let seed: u64 = a.get(5).and_then(|s| s.parse().ok()).unwrap_or(5151);
+    match faint_host::reproduce::mht::attribute(lambda, g1, trials, seed) {
+        Ok(rep) => {
+            println!(
+                "{}",
+                faint_host::reproduce::mht::StageReport::MARKDOWN_HEADER
+            );
+            println!("{}", rep.markdown_row(lambda, g1));
+            println!(
+                "peak fates (confirmed, short, merged, residual): {:?}",
+                rep.peak_fates
+            );
+            println!("false tracks: raw n_plots target_plots target_detected count_without_target shared_earlier");
+            for f in &rep.false_tracks {
+                println!(
+                    "  {:>3} {:>3} {:>3} {:>5} {:>3} {:>3}",
+                    f.raw,
+                    f.n_plots,
+                    f.target_plots,
+                    f.target_detected,
+                    f.count_without_target,
+                    f.shared_earlier
+                );
+            }
+        }
+        Err(e) => eprintln!("{e}"),
+    }
+}
+
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     if a.get(1).map(String::as_str) == Some("lost") {
         lost_targets(&a);
+        return;
+    }
+    if a.get(1).map(String::as_str) == Some("fig4") {
+        fig4(&a);
+        return;
+    }
+    if a.get(1).map(String::as_str) == Some("stages") {
+        stages(&a);
         return;
     }
     if a.get(1).map(String::as_str) == Some("fa") {

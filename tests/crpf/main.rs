@@ -10,3 +10,4 @@ mod noise;
 mod reproduce;
 mod sizes;
 mod statics;
+mod whiten;

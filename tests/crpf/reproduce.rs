@@ -21,6 +21,9 @@ fn quick_reproduction_writes_every_output() {
         sweeps: false,
         sweep_h0_trials: 1,
         sweep_trials: 1,
+        comparator_var: Default::default(),
+        comparator_likelihood: Default::default(),
+        window: Default::default(),
         quick: true,
     };
     run(&args).unwrap();

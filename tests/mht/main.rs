@@ -7,3 +7,5 @@ mod calibration;
 mod cli;
 mod detector;
 mod model;
+mod paper_gamma;
+mod stages;

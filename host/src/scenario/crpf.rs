@@ -25,7 +25,7 @@
 //!   `A in [0.05, 1.5]` (choice: SNR from -13 dB to +17 dB), `Pb = Pd = 0.05`,
 //!   `P(E_0 = 1) = 0.05` (see `faint_core::model::doppler::ModelConfig::othr`).
 
-use faint_core::model::doppler::ModelConfig;
+use faint_core::model::doppler::{ModelConfig, Window};
 use faint_core::rng::Rng;
 use faint_core::Complex32;
 use serde::Serialize;
@@ -65,6 +65,8 @@ pub struct Othr {
     pub noise_var: f64,
     /// Shape of the CGG noise.
     pub cgg_shape: f64,
+    /// Analysis window (the preset: Hamming).
+    pub window: Window,
 }
 
 impl Default for Othr {
@@ -81,6 +83,7 @@ impl Default for Othr {
             fda0: (-0.5, 0.5),
             noise_var: 1.0,
             cgg_shape: 0.1,
+            window: Window::Hamming,
         }
     }
 }
@@ -94,27 +97,37 @@ pub struct Run {
     pub truth: Vec<Option<[f64; 3]>>,
 }
 
-/// Window coefficients of the preset.
+/// Window coefficients of the preset (Hamming).
 pub fn window(m: usize) -> Vec<f64> {
-    (0..m)
-        .map(|n| faint_core::model::doppler::Window::Hamming.coefficient(n, m))
-        .collect()
+    window_of(Window::Hamming, m)
+}
+
+/// Coefficients of an `m`-point `w` window.
+pub fn window_of(w: Window, m: usize) -> Vec<f64> {
+    (0..m).map(|n| w.coefficient(n, m)).collect()
 }
 
 impl Othr {
-    /// The detectors' shared model for this preset.
+    /// The detectors' shared model for this preset (with the scene's window).
     pub fn model(&self) -> ModelConfig {
-        ModelConfig::othr()
+        ModelConfig {
+            window: self.window,
+            ..ModelConfig::othr()
+        }
     }
 
     /// Per-bin noise variance `sigma0^2 = noise_var * sum w^2`.
     pub fn bin_noise_var(&self) -> f64 {
-        self.noise_var * window(self.m).iter().map(|w| w * w).sum::<f64>()
+        self.noise_var
+            * window_of(self.window, self.m)
+                .iter()
+                .map(|w| w * w)
+                .sum::<f64>()
     }
 
     /// Amplitude `A` of eq. 18's SNR (see the module docs).
     pub fn amplitude(&self, snr_db: f64) -> f64 {
-        let w = window(self.m);
+        let w = window_of(self.window, self.m);
         let s: f64 = w.iter().sum();
         (10f64.powf(snr_db / 10.0) * self.bin_noise_var()).sqrt() / s
     }
@@ -122,7 +135,7 @@ impl Othr {
     /// Simulates one run; `snr_db = None` is H0 (no target).
     pub fn simulate(&self, snr_db: Option<f64>, noise: Noise, rng: &mut Rng) -> Run {
         let m = self.m;
-        let w = window(m);
+        let w = window_of(self.window, m);
         let dt = self.ts * m as f64;
         let mut state = snr_db.map(|s| {
             [

@@ -46,6 +46,7 @@
 mod cache;
 mod motion;
 mod response;
+mod whiten;
 
 pub use cache::ProjectionCache;
 pub use motion::{Motion, PriorBox};
@@ -53,6 +54,7 @@ pub use response::{
     dtft, DopplerModel, Projection, Window, HALF_SPAN, MAX_BINS, RESPONSE_ERROR_BOUND, SPAN,
     TABLE_STEPS,
 };
+pub use whiten::unwindow;
 
 use crate::{Complex32, Error, Result};
 

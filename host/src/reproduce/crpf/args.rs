@@ -5,7 +5,28 @@ use std::path::PathBuf;
 
 use anyhow::{ensure, Context, Result};
 
-use crate::scenario::crpf::Noise;
+use super::evaluation::{ComparatorModel, Likelihood, VarSource};
+use crate::scenario::crpf::{Noise, Othr};
+use faint_core::model::doppler::Window;
+
+/// Analysis window of the scene and every detector's model (`--window`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum SceneWindow {
+    /// Symmetric Hamming (the preset; neighbouring bins correlated).
+    #[default]
+    Hamming,
+    /// Rectangular (independent bins).
+    Rectangular,
+}
+
+impl From<SceneWindow> for Window {
+    fn from(w: SceneWindow) -> Self {
+        match w {
+            SceneWindow::Hamming => Window::Hamming,
+            SceneWindow::Rectangular => Window::Rectangular,
+        }
+    }
+}
 
 /// Command-line arguments of `faint reproduce crpf`.
 #[derive(clap::Args, Debug, Clone)]
@@ -44,6 +65,18 @@ pub struct Args {
     /// H1 runs per sweep configuration.
     #[arg(long, default_value_t = 500)]
     pub sweep_trials: usize,
+    /// Per-bin noise variance of the Gaussian comparators: estimated from the run's
+    /// frames (`run`, the preset) or the scene's true value (`true`).
+    #[arg(long, value_enum, default_value_t = VarSource::Run)]
+    pub comparator_var: VarSource,
+    /// Likelihood of the Gaussian comparators: independent bins (the preset) or the
+    /// window's bin covariance taken into account (`window`: frames whitened, see
+    /// `faint_core::model::doppler::unwindow`).
+    #[arg(long, value_enum, default_value_t = Likelihood::Independent)]
+    pub comparator_likelihood: Likelihood,
+    /// Analysis window of the scene and of every detector's model.
+    #[arg(long, value_enum, default_value_t = SceneWindow::Hamming)]
+    pub window: SceneWindow,
     /// Small preset for CI: N = 100, 60 H1 runs per point, 400 H0 runs, Pfa 0.05,
     /// SNR 0:16:4, sweeps with 200 + 40 runs.
     #[arg(long)]
@@ -65,6 +98,31 @@ impl Args {
             a.sweep_trials = 40;
         }
         a
+    }
+
+    /// The comparators' noise model for scene `sc`.
+    pub fn comparator_model(&self, sc: &Othr) -> ComparatorModel {
+        ComparatorModel {
+            var: self.comparator_var,
+            likelihood: self.comparator_likelihood,
+            time_var: sc.noise_var,
+        }
+    }
+
+    /// Output sub-directory: `<noise>_n<N>`, with `_var-true`, `_lik-window`, `_rect`
+    /// for the non-preset comparator variance, likelihood and window.
+    pub fn tag(&self) -> String {
+        let mut t = format!("{:?}_n{}", self.noise, self.particles).to_lowercase();
+        if self.comparator_var == VarSource::True {
+            t += "_var-true";
+        }
+        if self.comparator_likelihood == Likelihood::Window {
+            t += "_lik-window";
+        }
+        if self.window == SceneWindow::Rectangular {
+            t += "_rect";
+        }
+        t
     }
 
     /// Checks every argument before any work is done (so a bad combination fails at

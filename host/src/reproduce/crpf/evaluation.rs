@@ -9,7 +9,7 @@ use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint_core::detect::Detector;
-use faint_core::model::doppler::{estimate_noise_variance, DopplerReport};
+use faint_core::model::doppler::{estimate_noise_variance, unwindow, DopplerReport, Window};
 use faint_core::rng::{derive_seed, Rng};
 use faint_core::statistic::{d_k, zeta_k};
 use faint_core::Complex32;
@@ -58,6 +58,108 @@ impl Stats {
     }
 }
 
+/// Where the Gaussian comparators' per-bin noise variance comes from (`--comparator-var`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum VarSource {
+    /// Estimated from the run's K frames, `sum_k ||z_k||^2 / (K m)` (includes the target).
+    #[default]
+    Run,
+    /// The scene's true per-bin variance (time-domain variance times `sum w^2`, or `m`
+    /// for whitened frames).
+    True,
+}
+
+/// The Gaussian comparators' likelihood (`--comparator-likelihood`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Likelihood {
+    /// Independent bins of the windowed frame (the preset).
+    #[default]
+    Independent,
+    /// The window's bin covariance taken into account: frames whitened by
+    /// [`unwindow`], the rectangular window's response, per-bin variance `m s2`
+    /// (the exact Gaussian likelihood under the correlated bins; `faint_core::model::doppler`
+    /// module `whiten`).
+    Window,
+}
+
+/// The comparators' noise model.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ComparatorModel {
+    /// Variance source.
+    pub var: VarSource,
+    /// Likelihood.
+    pub likelihood: Likelihood,
+    /// The scene's time-domain noise variance (for [`VarSource::True`]).
+    pub time_var: f64,
+}
+
+impl Default for ComparatorModel {
+    fn default() -> Self {
+        Self {
+            var: VarSource::Run,
+            likelihood: Likelihood::Independent,
+            time_var: 1.0,
+        }
+    }
+}
+
+/// Whether (and how) the Gaussian comparators run: `true` is the default
+/// [`ComparatorModel`], `false` CRPF-TBD alone.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Comparators(pub Option<ComparatorModel>);
+
+impl From<bool> for Comparators {
+    fn from(on: bool) -> Self {
+        Self(on.then(ComparatorModel::default))
+    }
+}
+
+impl From<ComparatorModel> for Comparators {
+    fn from(m: ComparatorModel) -> Self {
+        Self(Some(m))
+    }
+}
+
+/// The comparators' frames, model and per-bin variance for one run under `cm`
+/// (`window`: the scene's and CRPF-TBD's analysis window).
+fn comparator_input(
+    run: &Run,
+    model: faint_core::model::doppler::ModelConfig,
+    cm: &ComparatorModel,
+) -> Result<(Option<Run>, GaussConfig)> {
+    let m = run.frames.first().map_or(0, Vec::len);
+    let window = model.window;
+    let (whitened, model) = match cm.likelihood {
+        Likelihood::Independent => (None, model),
+        Likelihood::Window => {
+            let mut frames = run.frames.clone();
+            for f in frames.iter_mut() {
+                unwindow(f, window).map_err(|e| anyhow::anyhow!("{e}"))?;
+            }
+            let mut rect = model;
+            rect.window = Window::Rectangular;
+            (
+                Some(Run {
+                    frames,
+                    truth: run.truth.clone(),
+                }),
+                rect,
+            )
+        }
+    };
+    let frames = whitened.as_ref().unwrap_or(run);
+    let noise_var = match cm.var {
+        VarSource::Run => estimate_noise_variance(frames.frames.iter().map(|f| f.as_slice()), m)?,
+        VarSource::True => {
+            let e: f64 = (0..m).map(|n| model.window.coefficient(n, m).powi(2)).sum();
+            (cm.time_var * e) as f32
+        }
+    };
+    Ok((whitened, GaussConfig { model, noise_var }))
+}
+
 /// Runs a detector over a run's frames; returns the per-frame reports.
 pub fn run_detector<D: Detector<Frame = [Complex32], Report = DopplerReport> + ?Sized>(
     det: &mut D,
@@ -93,7 +195,7 @@ fn stats_of<const N: usize>(
     run: &Run,
     crpf_cfg: &CrpfConfig,
     seed: u64,
-    comparators: bool,
+    comparators: Comparators,
 ) -> Result<Stats> {
     let mut crpf = Box::new(CrpfTbd::<N>::new(*crpf_cfg, derive_seed(seed, 1))?);
     let rc = run_detector(crpf.as_mut(), run)?;
@@ -104,14 +206,11 @@ fn stats_of<const N: usize>(
         crpf_fd_err: doppler_error(&rc, run, 50.0),
         ..Stats::default()
     };
-    if !comparators {
+    let Some(cm) = comparators.0 else {
         return Ok(st);
-    }
-    let var = estimate_noise_variance(run.frames.iter().map(|f| f.as_slice()), 32)?;
-    let g = GaussConfig {
-        model: crpf_cfg.model,
-        noise_var: var,
     };
+    let (whitened, g) = comparator_input(run, crpf_cfg.model, &cm)?;
+    let run = whitened.as_ref().unwrap_or(run);
     let mut pf = Box::new(PfTbd::<N>::new(g, derive_seed(seed, 2))?);
     let rp: Vec<f32> = run_detector(pf.as_mut(), run)?
         .iter()
@@ -140,8 +239,9 @@ pub fn run_stats(
     run: &Run,
     crpf_cfg: &CrpfConfig,
     seed: u64,
-    comparators: bool,
+    comparators: impl Into<Comparators>,
 ) -> Result<Stats> {
+    let comparators = comparators.into();
     match particles {
         100 => stats_of::<100>(run, crpf_cfg, seed, comparators),
         250 => stats_of::<250>(run, crpf_cfg, seed, comparators),
@@ -164,9 +264,10 @@ pub fn batch(
     crpf_cfg: &CrpfConfig,
     trials: usize,
     master: u64,
-    comparators: bool,
+    comparators: impl Into<Comparators>,
     label: &str,
 ) -> Result<Vec<Stats>> {
+    let comparators = comparators.into();
     run_trials(master, trials, label, |i, rng: &mut Rng| {
         let run = scenario.simulate(snr_db, noise, rng);
         run_stats(
@@ -254,7 +355,7 @@ pub(super) fn pd_vs_snr(
             cfg,
             a.trials,
             derive_seed(a.seed, 100 + j as u64),
-            true,
+            a.comparator_model(sc),
             &format!("crpf {snr} dB"),
         )?;
         for (m, name) in METHODS.iter().enumerate() {

@@ -24,18 +24,25 @@ use faint_core::rng::derive_seed;
 
 use crate::scenario::crpf::Othr;
 
-pub use args::{parse_grid, Args, PARTICLES};
+pub use args::{parse_grid, Args, SceneWindow, PARTICLES};
 pub use calibration::calibration;
-pub use evaluation::{batch, run_detector, run_stats, Stats, METHODS};
+pub use evaluation::{
+    batch, run_detector, run_stats, ComparatorModel, Comparators, Likelihood, Stats, VarSource,
+    METHODS,
+};
 
 /// `faint reproduce crpf`.
 pub fn run(args: &Args) -> Result<()> {
     args.validate()?;
     let a = args.effective();
     let grid = parse_grid(&a.snr_db)?;
-    let sc = Othr::default();
-    let cfg = CrpfConfig::othr();
-    let tag = format!("{:?}_n{}", a.noise, a.particles).to_lowercase();
+    let sc = Othr {
+        window: a.window.into(),
+        ..Othr::default()
+    };
+    let mut cfg = CrpfConfig::othr();
+    cfg.model.window = sc.window;
+    let tag = a.tag();
     let dir = a.out.join(&tag);
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let t0 = std::time::Instant::now();
@@ -49,7 +56,7 @@ pub fn run(args: &Args) -> Result<()> {
         &cfg,
         a.h0_trials,
         derive_seed(a.seed, 0),
-        true,
+        a.comparator_model(&sc),
         "crpf H0",
     )?;
     let th = calibration::thresholds(&a, &h0)?;

@@ -4,7 +4,7 @@
 //! per-lambda summary against the models.
 
 use faint_core::detect::mht::{
-    ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, NO_PLOT,
+    ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, Track, NO_PLOT,
 };
 use faint_core::detect::Detector;
 
@@ -79,6 +79,29 @@ fn line_matches(theta: f32, c: f32, trial: &Trial, i: usize, t_scan: f32) -> boo
     })
 }
 
+/// Plots of `track` made by target `i`.
+pub fn target_plots_in(track: &Track<NS>, trial: &Trial, i: usize) -> usize {
+    (0..trial.scans.len())
+        .filter(|&s| {
+            track.plots[s] != NO_PLOT
+                && trial.scans[s].origin.get(usize::from(track.plots[s]))
+                    == Some(&Origin::Target(i))
+        })
+        .count()
+}
+
+/// The targets a confirmed track matches (scoring rule of the module doc: the line within
+/// `MATCH_TOL` of all the target's noise-free positions, or more than half of the track's
+/// plots the target's).
+pub fn track_targets(track: &Track<NS>, trial: &Trial, t_scan: f32) -> Vec<usize> {
+    (0..trial.targets.len())
+        .filter(|&i| {
+            line_matches(track.theta, track.c, trial, i, t_scan)
+                || 2 * target_plots_in(track, trial, i) > usize::from(track.n_plots)
+        })
+        .collect()
+}
+
 pub(super) fn max_count<const R: usize, const A: usize>(
     acc: &faint_core::detect::mht::Accumulator<R, A>,
 ) -> u8 {
@@ -126,20 +149,7 @@ pub fn evaluate_trial(
     let tracks = mht.tracks();
     let mut matched = vec![false; nt];
     for tr in tracks {
-        let n_of = |i: usize| {
-            (0..trial.scans.len())
-                .filter(|&s| {
-                    tr.plots[s] != NO_PLOT
-                        && trial.scans[s].origin[usize::from(tr.plots[s])] == Origin::Target(i)
-                })
-                .count()
-        };
-        let hits: Vec<usize> = (0..nt)
-            .filter(|&i| {
-                line_matches(tr.theta, tr.c, trial, i, sc.t_scan)
-                    || 2 * n_of(i) > usize::from(tr.n_plots)
-            })
-            .collect();
+        let hits = track_targets(tr, trial, sc.t_scan);
         if hits.is_empty() {
             st.mht_false += 1;
         } else if hits.iter().all(|&i| matched[i]) {

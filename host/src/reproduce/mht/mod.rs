@@ -27,6 +27,7 @@ mod args;
 mod calibration;
 mod evaluation;
 mod figures;
+mod stages;
 
 use crate::scenario::mht::SeaClutter;
 
@@ -36,8 +37,10 @@ pub use calibration::{
     thresholds_with, FalseTrackCounts, GridModel, PILOT_PERIODS,
 };
 pub use evaluation::{
-    detectors, evaluate_trial, Classic, Grid, Mht, TrialStats, MATCH_TOL, NR, NS, NT, P, TR,
+    detectors, evaluate_trial, target_plots_in, track_targets, Classic, Grid, Mht, TrialStats,
+    MATCH_TOL, NR, NS, NT, P, TR,
 };
+pub use stages::{attribute, stage3_fates, Fate, Loss, StageReport};
 
 /// Entry point.
 pub fn run(args: &Args) -> anyhow::Result<()> {
