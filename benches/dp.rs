@@ -39,6 +39,8 @@ fn frames() -> Vec<Vec<f32>> {
         .collect()
 }
 
+// The detectors are boxed by the caller to keep the 0.6 MB states off the stack.
+#[allow(clippy::boxed_local)]
 fn bench_one<D: DpTrack>(c: &mut Criterion, name: &str, mut det: Box<D>, cfg: DpConfig) {
     let fr = frames();
     det.configure(&cfg, 0).unwrap();

@@ -168,14 +168,13 @@ fn the_detectors_match_the_exact_cases() {
             _ => montecarlo::noise_check(|| Box::new(S::unconfigured()), &cfg, 1, &vt, PFA, 8, 5),
         }
         .unwrap();
-        for k in 0..2 {
-            let p = c.pfa[k];
-            let se = (p * (1.0 - p) / mc[k].exceed.samples as f64).sqrt();
+        for (k, (point, &p)) in mc.iter().zip(&c.pfa).enumerate() {
+            let se = (p * (1.0 - p) / point.exceed.samples as f64).sqrt();
             assert!(
-                (mc[k].exceed.rate - p).abs() < 8.0 * se,
+                (point.exceed.rate - p).abs() < 8.0 * se,
                 "{method:?} n = {}: detector {} vs law {p}",
                 k + 1,
-                mc[k].exceed.rate
+                point.exceed.rate
             );
         }
     }

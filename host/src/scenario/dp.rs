@@ -47,14 +47,45 @@ pub type Second9 = SecondOrderDp<SIDE, 9, HISTORY, { second_order_words(SIDE, 9,
 /// Second order, `q_B = 25`.
 pub type Second25 = SecondOrderDp<SIDE, 25, HISTORY, { second_order_words(SIDE, 25, HISTORY) }>;
 
+/// Detector types whose all-zero bytes are a valid value (the core's documented
+/// zeroed-static construction), so [`boxed`] may build them zeroed on the heap.
+///
+/// # Safety
+/// Every field of an implementing type must be an integer, a float, a bool, a fieldless
+/// enum with a zero discriminant, or an array or struct of those.
+pub unsafe trait ZeroValid {}
+
+// SAFETY: the DP detectors hold only integers, floats, bools, fieldless enums whose first
+// variant is 0, and arrays and structs of those (their `unconfigured()` is all zeros).
+unsafe impl ZeroValid for Arnold9 {}
+// SAFETY: as above.
+unsafe impl ZeroValid for Arnold25 {}
+// SAFETY: as above.
+unsafe impl ZeroValid for Pulford9 {}
+// SAFETY: as above.
+unsafe impl ZeroValid for Pulford25 {}
+// SAFETY: as above.
+unsafe impl ZeroValid for Second9 {}
+// SAFETY: as above.
+unsafe impl ZeroValid for Second25 {}
+
 /// A configured DP detector built on the heap: zeroed in place (the `q_B = 25` second
 /// order is 6.2 MB, more than a thread's stack), then configured with `cfg`.
-pub fn boxed<D: DpTrack>(cfg: &DpConfig) -> Result<Box<D>> {
-    // SAFETY: every field of the three DP detectors is an integer, a float, a bool, a
-    // fieldless enum (discriminant 0 exists) or an array or struct of those, so all-zero
-    // bytes are a valid value: the core's documented zeroed-static construction (tested
-    // in tests/dp). `configure` then sets every field it reads.
-    let mut d: Box<D> = unsafe { Box::<D>::new_zeroed().assume_init() };
+pub fn boxed<D: DpTrack + ZeroValid>(cfg: &DpConfig) -> Result<Box<D>> {
+    let layout = std::alloc::Layout::new::<D>();
+    if layout.size() == 0 {
+        anyhow::bail!("a DP detector cannot be zero-sized");
+    }
+    // SAFETY: the layout has a non-zero size; a null pointer is handled; all-zero bytes
+    // are a valid `D` (`ZeroValid`), and the allocation was made with `D`'s layout by the
+    // global allocator, as `Box::from_raw` requires.
+    let mut d: Box<D> = unsafe {
+        let p = std::alloc::alloc_zeroed(layout);
+        if p.is_null() {
+            std::alloc::handle_alloc_error(layout);
+        }
+        Box::from_raw(p.cast::<D>())
+    };
     d.configure(cfg, 0).map_err(|e| anyhow!("{e}"))?;
     Ok(d)
 }

@@ -563,7 +563,7 @@ fn table(pts: &[Point], level: Level, speed: u8) -> Option<String> {
     ))
 }
 
-fn find<'a>(pts: &'a [Point], level: Level, speed: u8, m: Method, snr: f64) -> Option<&'a Point> {
+fn find(pts: &[Point], level: Level, speed: u8, m: Method, snr: f64) -> Option<&Point> {
     pts.iter()
         .find(|p| p.level == level && p.speed == speed && p.method == m.name() && p.snr == snr)
 }
