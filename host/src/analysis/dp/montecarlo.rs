@@ -16,12 +16,12 @@
 //! (images are independent), not from a binomial over pixels. Targets are laid out so
 //! that no target's cone reaches another's track.
 
+use crate::montecarlo::run_trials;
 use anyhow::{bail, Result};
 use faint_core::detect::dp::{
     arnold_words, second_order_words, ArnoldDp, DpConfig, DpTrack, Method, SecondOrderDp,
 };
 use faint_core::rng::{derive_seed, Rng};
-use rayon::prelude::*;
 use std::collections::BTreeMap;
 
 /// A Monte Carlo rate with its standard error.
@@ -88,41 +88,37 @@ where
     let lsb = f64::from(cfg.lsb);
     type PerImage = Vec<(f64, usize, f64, BTreeMap<i64, u64>)>;
     let runs: Vec<Result<PerImage>> = pool()?.install(|| {
-        (0..images)
-            .into_par_iter()
-            .map(|i| {
-                let mut det = make();
-                det.configure(cfg, 0).map_err(|e| anyhow::anyhow!("{e}"))?;
-                let mut rng = Rng::from_stream(seed, i as u64);
-                let mut z = vec![0f32; m * m];
-                let mut out = Vec::with_capacity(n);
-                for (k, &vt) in thresholds.iter().enumerate() {
-                    noise_frame(&mut rng, cfg.sigma, &mut z);
-                    det.step(&z).map_err(|e| anyhow::anyhow!("{e}"))?;
-                    let margin = r * k;
-                    let (mut hit, mut all) = (0usize, 0usize);
-                    let mut hist = BTreeMap::new();
-                    let mut pairs = Vec::new();
-                    for y in margin..m - margin {
-                        let mut prev: Option<f64> = None;
-                        for x in margin..m - margin {
-                            let v = det.merit(x, y).unwrap_or(f32::MIN);
-                            all += 1;
-                            if v >= vt {
-                                hit += 1;
-                            }
-                            *hist.entry((f64::from(v) / lsb).round() as i64).or_insert(0) += 1;
-                            if let Some(p) = prev {
-                                pairs.push((p, f64::from(v)));
-                            }
-                            prev = Some(f64::from(v));
+        run_trials(seed, images, "DP noise check", |_, rng| {
+            let mut det = make();
+            det.configure(cfg, 0).map_err(|e| anyhow::anyhow!("{e}"))?;
+            let mut z = vec![0f32; m * m];
+            let mut out = Vec::with_capacity(n);
+            for (k, &vt) in thresholds.iter().enumerate() {
+                noise_frame(rng, cfg.sigma, &mut z);
+                det.step(&z).map_err(|e| anyhow::anyhow!("{e}"))?;
+                let margin = r * k;
+                let (mut hit, mut all) = (0usize, 0usize);
+                let mut hist = BTreeMap::new();
+                let mut pairs = Vec::new();
+                for y in margin..m - margin {
+                    let mut prev: Option<f64> = None;
+                    for x in margin..m - margin {
+                        let v = det.merit(x, y).unwrap_or(f32::MIN);
+                        all += 1;
+                        if v >= vt {
+                            hit += 1;
                         }
+                        *hist.entry((f64::from(v) / lsb).round() as i64).or_insert(0) += 1;
+                        if let Some(p) = prev {
+                            pairs.push((p, f64::from(v)));
+                        }
+                        prev = Some(f64::from(v));
                     }
-                    out.push((hit as f64 / all as f64, all, correlation(&pairs), hist));
                 }
-                Ok(out)
-            })
-            .collect()
+                out.push((hit as f64 / all as f64, all, correlation(&pairs), hist));
+            }
+            Ok(out)
+        })
     });
     let runs: Vec<PerImage> = runs.into_iter().collect::<Result<_>>()?;
     Ok((0..n)
@@ -254,50 +250,46 @@ where
     }
     // hits[image][frame][threshold set]
     let hits: Vec<Result<Vec<Vec<usize>>>> = pool()?.install(|| {
-        (0..images)
-            .into_par_iter()
-            .map(|i| {
-                let mut det = make();
-                det.configure(cfg, 0).map_err(|e| anyhow::anyhow!("{e}"))?;
-                let mut rng = Rng::from_stream(seed, i as u64);
-                let mut z = vec![0f32; m * m];
-                let mut out = Vec::with_capacity(n);
-                for k in 0..n {
-                    noise_frame(&mut rng, cfg.sigma, &mut z);
-                    let pos = |&(x, y): &(usize, usize)| {
-                        let px = x as i64 + i64::from(step.0) * k as i64;
-                        let py = y as i64 + i64::from(step.1) * k as i64;
-                        (px as usize, py as usize)
-                    };
-                    for s in &starts {
-                        let (x, y) = pos(s);
-                        if let Some(v) = z.get_mut(y * m + x) {
-                            *v += amp;
-                        }
+        run_trials(seed, images, "DP target check", |_, rng| {
+            let mut det = make();
+            det.configure(cfg, 0).map_err(|e| anyhow::anyhow!("{e}"))?;
+            let mut z = vec![0f32; m * m];
+            let mut out = Vec::with_capacity(n);
+            for k in 0..n {
+                noise_frame(rng, cfg.sigma, &mut z);
+                let pos = |&(x, y): &(usize, usize)| {
+                    let px = x as i64 + i64::from(step.0) * k as i64;
+                    let py = y as i64 + i64::from(step.1) * k as i64;
+                    (px as usize, py as usize)
+                };
+                for s in &starts {
+                    let (x, y) = pos(s);
+                    if let Some(v) = z.get_mut(y * m + x) {
+                        *v += amp;
                     }
-                    det.step(&z).map_err(|e| anyhow::anyhow!("{e}"))?;
-                    let merits: Vec<Option<f32>> = starts
-                        .iter()
-                        .map(|s| {
-                            let (x, y) = pos(s);
-                            det.merit(x, y)
-                        })
-                        .collect();
-                    out.push(
-                        thresholds
-                            .iter()
-                            .map(|t| {
-                                merits
-                                    .iter()
-                                    .filter(|v| v.is_some_and(|v| v >= t[k]))
-                                    .count()
-                            })
-                            .collect(),
-                    );
                 }
-                Ok(out)
-            })
-            .collect()
+                det.step(&z).map_err(|e| anyhow::anyhow!("{e}"))?;
+                let merits: Vec<Option<f32>> = starts
+                    .iter()
+                    .map(|s| {
+                        let (x, y) = pos(s);
+                        det.merit(x, y)
+                    })
+                    .collect();
+                out.push(
+                    thresholds
+                        .iter()
+                        .map(|t| {
+                            merits
+                                .iter()
+                                .filter(|v| v.is_some_and(|v| v >= t[k]))
+                                .count()
+                        })
+                        .collect(),
+                );
+            }
+            Ok(out)
+        })
     });
     let hits: Vec<Vec<Vec<usize>>> = hits.into_iter().collect::<Result<_>>()?;
     let total = images * starts.len();
