@@ -62,8 +62,9 @@ struct DetectArgs {
     /// detections against with GOSPA.
     #[arg(long)]
     truth: Option<PathBuf>,
-    /// GOSPA cut-off `c` in the position's units [default: 2 Hz Doppler, 100 m x/y].
-    #[arg(long)]
+    /// GOSPA cut-off `c` in the position's units, finite and > 0 [default: 2 Hz Doppler,
+    /// 100 m x/y].
+    #[arg(long, allow_hyphen_values = true)]
     gospa_c: Option<f64>,
     /// Write (and score) only detections with at least this score [default: 0.5 for an
     /// existence probability, everything otherwise].
@@ -94,18 +95,19 @@ struct SimulateArgs {
     /// Seed.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// SNR in dB (othr: eq. 18 of Lu et al. 2017, default 8; six-targets: default 9;
-    /// rotor-uav: default 10).
+    /// SNR in dB, in [-60, 60] (othr: eq. 18 of Lu et al. 2017, default 8; six-targets:
+    /// default 9; rotor-uav: default 10).
     #[arg(long, allow_hyphen_values = true)]
     snr_db: Option<f64>,
-    /// Frames to write [default: one run of the preset].
+    /// Frames to write, 1 to 1000000 (at most the preset's 40 for six-targets,
+    /// rotor-uav and dim-point) [default: one run of the preset].
     #[arg(long)]
     frames: Option<usize>,
-    /// Clutter plots per scan (sea-clutter) [default: 80].
-    #[arg(long)]
+    /// Clutter plots per scan, in [0, 10000] (sea-clutter) [default: 80].
+    #[arg(long, allow_hyphen_values = true)]
     lambda: Option<f32>,
-    /// SNR `a / sigma`, linear (dim-point) [default: 2].
-    #[arg(long)]
+    /// SNR `a / sigma`, linear, in [0, 100] (dim-point) [default: 2].
+    #[arg(long, allow_hyphen_values = true)]
     snr: Option<f64>,
     /// Target speed in px/frame, 1 or 2 (dim-point) [default: 1].
     #[arg(long)]

@@ -12,11 +12,13 @@
 //! - [`reproduce`]: one module per paper, behind `faint reproduce <name>`.
 //! - [`detect`]: every detector on a user's files, behind `faint detect <name>`.
 //! - [`timing`]: this thread's CPU time, for measurements on a shared machine.
+//! - [`cli`]: checks and parsers of command-line values shared by every command.
 //! - [`simulate`]: a preset's frames and truth as files, behind `faint simulate <scenario>`.
 
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod cli;
 pub mod detect;
 pub mod io;
 pub mod montecarlo;

@@ -24,6 +24,7 @@ use anyhow::{bail, ensure, Result};
 use faint_core::rng::Rng;
 use serde::Serialize;
 
+use crate::cli;
 use crate::io::output::{write_complex_frames, write_plots, write_real_frames};
 use crate::io::write_csv;
 use crate::scenario::cbmember::{MapSource, RotorUav};
@@ -114,19 +115,16 @@ fn extension_is(out: &Path, ext: &str, scenario: &str) -> Result<()> {
 /// Checks the arguments against the scenario (before anything is drawn or written).
 pub fn check(spec: &Spec) -> Result<()> {
     if let Some(k) = spec.frames {
-        ensure!(k > 0, "--frames 0: at least one frame is needed");
+        cli::runs("--frames", k)?;
     }
     if let Some(s) = spec.snr_db {
-        ensure!(s.is_finite(), "--snr-db {s}: must be finite");
+        cli::snr_db("--snr-db", s)?;
     }
     match spec.scenario.as_str() {
         "othr" => extension_is(&spec.out, "npy", "othr"),
         "sea-clutter" => {
             if let Some(l) = spec.lambda {
-                ensure!(
-                    (0.0..=10_000.0).contains(&l),
-                    "--lambda {l}: must be in [0, 10000] plots per scan"
-                );
+                cli::within("--lambda", l.into(), 0.0..=10_000.0, " plots per scan")?;
             }
             ensure!(
                 spec.snr_db.is_none(),
@@ -158,10 +156,7 @@ pub fn check(spec: &Spec) -> Result<()> {
                 "--snr-db: dim-point's SNR is the linear a / sigma (use --snr)"
             );
             if let Some(s) = spec.snr {
-                ensure!(
-                    (0.0..=100.0).contains(&s),
-                    "--snr {s}: must lie in [0, 100] (a / sigma)"
-                );
+                cli::within("--snr", s, 0.0..=100.0, " (a / sigma)")?;
             }
             if let Some(v) = spec.speed {
                 qb_for(v).map_err(|e| anyhow::anyhow!("--speed: {e}"))?;

@@ -79,3 +79,56 @@ fn reproduce_cbmember_rejects_bad_arguments_before_any_run() {
         assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: {stderr}");
     }
 }
+
+#[test]
+fn reproduce_cbmember_names_the_bad_value_and_path() {
+    for (args, needle) in [
+        (
+            vec!["--snr-db", "0:1:inf"],
+            "--snr-db: 'inf' is not a finite number",
+        ),
+        (
+            vec!["--snr-db", "0:1:1:1"],
+            "--snr-db: '0:1:1:1' is not a grid a:b:step",
+        ),
+        (
+            vec!["--snr-db", "0:1e9:1"],
+            "has 1000000001 points, at most 1000",
+        ),
+        (
+            vec!["--snr-db", "-90:-80:5"],
+            "--snr-db must lie in [-60, 60] dB, got -90",
+        ),
+        (
+            vec!["--physical-snr-db", "0:100:50"],
+            "--physical-snr-db must lie in [-60, 60] dB",
+        ),
+        (
+            vec!["--quick", "--particles", "0"],
+            "--particles must lie in 1..=1500, got 0",
+        ),
+        (
+            vec!["--quick", "--timing-frames", "0"],
+            "--timing-frames must lie in 1..=100",
+        ),
+        (
+            vec!["--quick", "--runs", "2000000"],
+            "--runs must lie in 1..=1000000",
+        ),
+        (
+            vec!["--quick", "--out", "/proc/faint-no-such-dir"],
+            "--out /proc/faint-no-such-dir",
+        ),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_faint"))
+            .args(["--quiet", "reproduce", "cbmember"])
+            .args(&args)
+            .output()
+            .expect("run faint");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} accepted");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: {stderr}");
+    }
+}

@@ -1,8 +1,9 @@
 //! `faint reproduce crpf --quick` end to end: every output file is written and the CSVs
 //! hold finite Pd values for every method and SNR point.
 
+use faint::host::cli::grid;
 use faint::host::montecarlo::set_quiet;
-use faint::host::reproduce::crpf::{parse_grid, run, Args, METHODS};
+use faint::host::reproduce::crpf::{run, Args, METHODS};
 use faint::host::scenario::crpf::Noise;
 
 #[test]
@@ -10,17 +11,17 @@ fn quick_reproduction_writes_every_output() {
     set_quiet(true);
     let out = std::env::temp_dir().join(format!("faint_crpf_quick_{}", std::process::id()));
     let args = Args {
-        particles: 1000,
-        trials: 1,
-        h0_trials: 1,
-        pfa: 0.5,
+        particles: None,
+        trials: None,
+        h0_trials: None,
+        pfa: None,
         noise: Noise::Cgg,
-        snr_db: String::new(),
+        snr_db: None,
         out: out.clone(),
         seed: 5,
         sweeps: false,
-        sweep_h0_trials: 1,
-        sweep_trials: 1,
+        sweep_h0_trials: None,
+        sweep_trials: None,
         comparator_var: Default::default(),
         comparator_likelihood: Default::default(),
         window: Default::default(),
@@ -51,10 +52,12 @@ fn quick_reproduction_writes_every_output() {
 
 #[test]
 fn snr_grid_parsing() {
-    assert_eq!(parse_grid("0:4:2").unwrap(), vec![0.0, 2.0, 4.0]);
-    assert_eq!(parse_grid("-2:-2:1").unwrap(), vec![-2.0]);
-    assert!(parse_grid("0:4").is_err());
-    assert!(parse_grid("0:4:0").is_err());
-    assert!(parse_grid("4:0:1").is_err());
-    assert!(parse_grid("a:b:c").is_err());
+    let g = |s: &str| grid("--snr-db", s);
+    assert_eq!(g("0:4:2").unwrap(), vec![0.0, 2.0, 4.0]);
+    assert_eq!(g("-2:-2:1").unwrap(), vec![-2.0]);
+    assert!(g("0:4").is_err());
+    assert!(g("0:4:0").is_err());
+    assert!(g("4:0:1").is_err());
+    assert!(g("a:b:c").is_err());
+    assert!(g("0:1:inf").is_err());
 }

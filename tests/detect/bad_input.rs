@@ -192,7 +192,7 @@ fn bad_simulate_arguments() {
         ),
         (
             vec!["simulate", "othr", "--out", "x.npy", "--frames", "0"],
-            "--frames 0",
+            "--frames must lie in 1..=1000000, got 0",
         ),
         (
             vec![
@@ -240,4 +240,88 @@ fn list_names_every_detector() {
     ] {
         assert!(out.lines().any(|l| l.starts_with(name)), "{name}: {out}");
     }
+}
+
+#[test]
+fn bad_numbers_name_the_argument_and_value() {
+    let dir = temp("bad-numbers");
+    let out = dir.join("out");
+    let frames = dir.join("othr.npy");
+    assert_eq!(
+        faint(&["simulate", "othr", "--out", s(&frames), "--frames", "2"]).0,
+        0
+    );
+    let input = s(&frames);
+    for (args, needle) in [
+        (
+            vec!["--gospa-c", "inf"],
+            "--gospa-c inf: must be finite and > 0",
+        ),
+        (
+            vec!["--gospa-c", "nan"],
+            "--gospa-c NaN: must be finite and > 0",
+        ),
+        (vec!["--min-score", "nan"], "--min-score: must be a number"),
+        (vec!["--gospa-c", "-1"], "--gospa-c -1: must be finite and > 0"),
+    ] {
+        let mut all = vec!["detect", "crpf", "--input", input];
+        all.extend(args);
+        fails(&all, &out, &[needle]);
+    }
+    let x = dir.join("x.npy");
+    let xc = dir.join("x.csv");
+    for (args, needle) in [
+        (
+            vec!["othr", "--out", s(&x), "--snr-db", "inf"],
+            "--snr-db: 'inf' is not a finite number",
+        ),
+        (
+            vec!["othr", "--out", s(&x), "--snr-db", "1e300"],
+            "--snr-db must lie in [-60, 60] dB, got 1e300",
+        ),
+        (
+            vec!["othr", "--out", s(&x), "--frames", "2000000"],
+            "--frames must lie in 1..=1000000, got 2000000",
+        ),
+        (
+            vec!["sea-clutter", "--out", s(&xc), "--lambda", "nan"],
+            "--lambda: 'NaN' is not a finite number",
+        ),
+        (
+            vec!["sea-clutter", "--out", s(&xc), "--lambda", "-1"],
+            "--lambda must lie in [0, 10000] plots per scan, got -1",
+        ),
+        (
+            vec!["dim-point", "--out", s(&x), "--snr", "inf"],
+            "--snr: 'inf' is not a finite number",
+        ),
+        (
+            vec!["dim-point", "--out", s(&x), "--snr", "200"],
+            "--snr must lie in [0, 100] (a / sigma), got 200",
+        ),
+    ] {
+        let mut all = vec!["simulate"];
+        all.extend(args);
+        let (code, _, err) = faint(&all);
+        assert_eq!(code, 2, "{all:?}: {err}");
+        assert!(err.contains(needle), "{all:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(!x.exists() && !xc.exists(), "{all:?} wrote a file");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn simulate_unwritable_out_is_named() {
+    let (code, _, err) = faint(&[
+        "simulate",
+        "othr",
+        "--out",
+        "/proc/faint-no-such-dir/x.npy",
+        "--frames",
+        "2",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("/proc/faint-no-such-dir"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }

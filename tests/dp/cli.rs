@@ -68,3 +68,54 @@ fn bad_arguments_name_the_argument() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn bad_values_and_paths_are_one_line_naming_them() {
+    let dir = temp("bad-values");
+    let _ = std::fs::remove_dir_all(&dir);
+    for (args, needle) in [
+        (
+            &["--snr", "0:1:inf"][..],
+            "--snr: 'inf' is not a finite number",
+        ),
+        (
+            &["--snr", "0:100:0.01"][..],
+            "--snr: '0:100:0.01' has 10001 points, at most 1000",
+        ),
+        (
+            &["--snr", "1:200:100"][..],
+            "--snr must lie in [0, 100] (a / sigma), got 101",
+        ),
+        (
+            &["--snr=-1:1:1"][..],
+            "--snr must lie in [0, 100] (a / sigma), got -1",
+        ),
+        (
+            &["--runs", "0"][..],
+            "--runs must lie in 1..=1000000, got 0",
+        ),
+        (
+            &["--noise-runs", "0"][..],
+            "--noise-runs must lie in 100..=1000000, got 0",
+        ),
+        (&["--frames", "0"][..], "--frames must lie in 1..=40, got 0"),
+    ] {
+        let mut all = vec!["reproduce", "dp", "--quick", "--out", s(&dir)];
+        all.extend(args);
+        let (code, _, err) = faint(&all);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(!dir.exists(), "{args:?} created {}", dir.display());
+    }
+    let (code, _, err) = faint(&[
+        "reproduce",
+        "dp",
+        "--quick",
+        "--out",
+        "/proc/faint-no-such-dir",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--out /proc/faint-no-such-dir"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+}

@@ -1,4 +1,6 @@
-//! `faint reproduce phd --quick` (and its alias `psophd`) runs end to end and writes its outputs.
+//! `faint reproduce phd --quick` (and its alias `psophd`) runs end to end and writes its
+//! outputs; bad arguments are one line naming the argument; `--quick` never overrides a
+//! value given.
 
 use std::process::Command;
 
@@ -46,4 +48,94 @@ fn reproduce_psophd_rejects_bad_arguments_before_any_run() {
         assert!(!out.status.success(), "{args:?} accepted");
         assert!(stderr.contains(needle), "{args:?}: {stderr}");
     }
+}
+
+/// Runs `faint --quiet reproduce phd <args>`: `(exit code, stderr)`.
+fn phd(args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_faint"))
+        .args(["--quiet", "reproduce", "phd"])
+        .args(args)
+        .output()
+        .expect("run faint");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn counts_and_snrs_are_checked_quick_or_not() {
+    let dir = std::env::temp_dir().join(format!("faint-phd-bad-{}", std::process::id()));
+    let out = dir.to_str().unwrap();
+    for (args, needle) in [
+        (
+            &["--runs", "0"][..],
+            "--runs must lie in 1..=1000000, got 0",
+        ),
+        (
+            &["--quick", "--runs", "0"][..],
+            "--runs must lie in 1..=1000000, got 0",
+        ),
+        (&["--runs", "2000000"][..], "--runs must lie in 1..=1000000"),
+        (
+            &["--snr-db", "inf"][..],
+            "--snr-db: 'inf' is not a finite number",
+        ),
+        (
+            &["--quick", "--snr-db", "9,nan"][..],
+            "--snr-db: 'NaN' is not a finite number",
+        ),
+        (
+            &["--snr-db", "1e300"][..],
+            "--snr-db must lie in [-60, 60] dB",
+        ),
+        (
+            &["--snr-db", "-70"][..],
+            "--snr-db must lie in [-60, 60] dB, got -70",
+        ),
+        (
+            &["--quick", "--birth-pair-speed=-1"][..],
+            "--birth-pair-speed",
+        ),
+    ] {
+        let mut all = vec!["--out", out];
+        all.extend_from_slice(args);
+        let (code, err) = phd(&all);
+        assert_ne!(code, 0, "{args:?}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(!dir.exists(), "{args:?} created {}", dir.display());
+    }
+}
+
+#[test]
+fn unwritable_out_is_named_before_any_run() {
+    let (code, err) = phd(&["--runs", "100000", "--out", "/proc/faint-no-such-dir"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("--out /proc/faint-no-such-dir"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+}
+
+#[test]
+fn quick_keeps_given_values() {
+    let dir = std::env::temp_dir().join(format!("faint-phd-keep-{}", std::process::id()));
+    let out = Command::new(env!("CARGO_BIN_EXE_faint"))
+        .args(["--quiet", "reproduce", "phd", "--quick", "--runs", "1"])
+        .args(["--snr-db", "7", "--out"])
+        .arg(&dir)
+        .output()
+        .expect("run faint");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary = std::fs::read_to_string(dir.join("summary.csv")).unwrap();
+    let rows: Vec<&str> = summary.lines().skip(1).collect();
+    assert_eq!(rows.len(), 3, "{summary}");
+    for r in rows {
+        assert!(r.starts_with("7.0,") && r.contains(",1,"), "{summary}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

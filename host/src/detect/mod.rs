@@ -47,7 +47,7 @@ use crate::timing::thread_cpu_seconds as cpu;
 
 mod output;
 
-pub use output::{check_input, check_out_dir, read_truth, write, write_plots, Written};
+pub use output::{check_input, read_truth, write, write_plots, Written};
 
 /// Particle counts the particle-filter detectors are built for (the capacity is a
 /// compile-time constant of the core).

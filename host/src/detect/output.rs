@@ -1,7 +1,6 @@
 //! What `faint detect` writes, and the truth file it scores against.
 
 use std::collections::BTreeMap;
-use std::fs;
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, ensure, Context, Result};
@@ -110,17 +109,6 @@ struct GospaRow {
     false_targets: f64,
 }
 
-/// Checks that `dir` can be written (creates it); names it otherwise.
-pub fn check_out_dir(dir: &Path) -> Result<()> {
-    fs::create_dir_all(dir)
-        .with_context(|| format!("--out {}: cannot create the folder", dir.display()))?;
-    let probe = dir.join(".faint-write-test");
-    fs::write(&probe, b"")
-        .with_context(|| format!("--out {}: the folder is not writable", dir.display()))?;
-    fs::remove_file(&probe).ok();
-    Ok(())
-}
-
 /// Writes the outcome's data files to `dir`: the detections with a score of at least
 /// `min_score` (`detections.csv`, `detections.json`), every frame's count and best score
 /// (`summary.csv`, unfiltered), the reports if collected (`reports.json`) and, with a
@@ -133,7 +121,7 @@ pub fn write(
     truth: Option<&[Vec<Vec<f64>>]>,
     c: f64,
 ) -> Result<Written> {
-    check_out_dir(dir)?;
+    crate::cli::out_dir(dir)?;
     let kept: Vec<&super::Row> = out.rows.iter().filter(|r| r.score >= min_score).collect();
     // detections.csv: fixed columns, then one per state component.
     let path = dir.join("detections.csv");

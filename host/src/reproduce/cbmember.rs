@@ -27,9 +27,9 @@ use faint_core::model::range_doppler::{quantise, Dequant, PointModel};
 use faint_core::rng::{derive_seed, Rng};
 use serde::Serialize;
 
+use crate::cli;
 use crate::io::{self, plot::Series};
 use crate::montecarlo::run_trials;
-use crate::reproduce::crpf::parse_grid;
 use crate::scenario::cbmember::{HostFilter, HostFilterU8, MapKind, MapSource, RotorUav};
 use crate::stats::detection::{proportion, snr_at_pd, PdPoint, Proportion};
 use crate::stats::ospa::ospa;
@@ -40,20 +40,21 @@ pub const MAX_PARTICLES: usize = 1500;
 /// Command-line arguments of `faint reproduce cbmember`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
-    /// Monte Carlo runs per SNR point (default 100; --quick: 2).
+    /// Monte Carlo runs per SNR point, 1 to 1000000 (default 100; --quick: 2).
     #[arg(long)]
     pub runs: Option<usize>,
-    /// SNR grid `a:b:step` in dB, eq. 19 peak-pixel SNR (default -24:-8:2; --quick
-    /// -14:-10:4).
-    #[arg(long)]
+    /// SNR grid `a:b:step` in dB, eq. 19 peak-pixel SNR, values in [-60, 60], at most
+    /// 1000 points (default -24:-8:2; --quick -14:-10:4).
+    #[arg(long, allow_hyphen_values = true)]
     pub snr_db: Option<String>,
-    /// SNR grid of the physical-generator ablation (default -4:24:4; --quick 8:16:8).
-    #[arg(long)]
+    /// SNR grid of the physical-generator ablation, as `--snr-db` (default -4:24:4;
+    /// --quick 8:16:8).
+    #[arg(long, allow_hyphen_values = true)]
     pub physical_snr_db: Option<String>,
-    /// `L_max` values of Fig. 11 (default 700,1000,1500; --quick 700).
+    /// `L_max` values of Fig. 11, each 1 to 1500 (default 700,1000,1500; --quick 700).
     #[arg(long, value_delimiter = ',')]
     pub particles: Option<Vec<usize>>,
-    /// Frames of the Table 3 timing run (default 100; --quick 10).
+    /// Frames of the Table 3 timing run, 1 to 100 (default 100; --quick 10).
     #[arg(long)]
     pub timing_frames: Option<usize>,
     /// Output directory.
@@ -96,24 +97,22 @@ struct Effective {
 impl Args {
     fn effective(&self) -> Result<Effective> {
         let q = self.quick;
-        let runs = self.runs.unwrap_or(if q { 2 } else { 100 });
-        ensure!(runs >= 1, "--runs must be at least 1, got {runs}");
+        let runs = cli::runs("--runs", self.runs.unwrap_or(if q { 2 } else { 100 }))?;
         let grid = self
             .snr_db
             .clone()
             .unwrap_or_else(|| if q { "-14:-10:4" } else { "-24:-8:2" }.into());
-        let snrs = parse_grid(&grid).map_err(|e| anyhow::anyhow!("--snr-db: {e}"))?;
+        let snrs = cli::grid("--snr-db", &grid)?;
+        for &s in &snrs {
+            cli::snr_db("--snr-db", s)?;
+        }
         let pgrid = self
             .physical_snr_db
             .clone()
             .unwrap_or_else(|| if q { "8:16:8" } else { "-4:24:4" }.into());
-        let physical_snrs =
-            parse_grid(&pgrid).map_err(|e| anyhow::anyhow!("--physical-snr-db: {e}"))?;
-        for s in snrs.iter().chain(&physical_snrs) {
-            ensure!(
-                (-60.0..=60.0).contains(s),
-                "--snr-db / --physical-snr-db values must lie in [-60, 60] dB, got {s}"
-            );
+        let physical_snrs = cli::grid("--physical-snr-db", &pgrid)?;
+        for &s in &physical_snrs {
+            cli::snr_db("--physical-snr-db", s)?;
         }
         let particles = self.particles.clone().unwrap_or_else(|| {
             if q {
@@ -127,16 +126,11 @@ impl Args {
             "--particles needs at least one value"
         );
         for &p in &particles {
-            ensure!(
-                (1..=MAX_PARTICLES).contains(&p),
-                "--particles values must lie in 1..={MAX_PARTICLES}, got {p}"
-            );
+            cli::count("--particles", p, 1..=MAX_PARTICLES)?;
         }
         let timing_frames = self.timing_frames.unwrap_or(if q { 10 } else { 100 });
-        ensure!(
-            (1..=100).contains(&timing_frames),
-            "--timing-frames must lie in 1..=100 (the truth leaves the map after 100 frames), got {timing_frames}"
-        );
+        // The truth leaves the map after 100 frames.
+        cli::count("--timing-frames", timing_frames, 1..=100)?;
         let sets = self
             .sets
             .clone()
@@ -536,6 +530,7 @@ pub fn run(args: &Args) -> Result<()> {
         .context("thread pool")?;
     let want = |s: &str| e.sets.iter().any(|x| x == s);
     let d = &args.out;
+    cli::out_dir(d)?;
     let previous: Vec<Row> = match &args.previous {
         Some(p) => {
             let mut r = csv::Reader::from_path(p)

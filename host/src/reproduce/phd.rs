@@ -17,6 +17,7 @@ use anyhow::{Context, Result};
 use faint_core::rng::Rng;
 use serde::Serialize;
 
+use crate::cli;
 use crate::io::{self, plot::Series};
 use crate::montecarlo::run_trials;
 use crate::scenario::phd::{HostFilter, SixTargets, Variant};
@@ -25,30 +26,58 @@ use crate::stats::ospa::ospa;
 /// Command-line arguments.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
-    /// SNRs in dB.
-    #[arg(long, value_delimiter = ',', default_value = "9,7,5")]
-    pub snr_db: Vec<f64>,
-    /// Monte Carlo runs per SNR (paper: 100).
-    #[arg(long, default_value_t = 100)]
-    pub runs: usize,
+    /// SNRs in dB, each in [-60, 60] (default 9,7,5; --quick 9).
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub snr_db: Option<Vec<f64>>,
+    /// Monte Carlo runs per SNR, 1 to 1000000 (paper and default: 100; --quick 2).
+    #[arg(long)]
+    pub runs: Option<usize>,
     /// Output directory.
     #[arg(long, default_value = "out/phd")]
     pub out: PathBuf,
     /// Master seed.
     #[arg(long, default_value_t = 2019)]
     pub seed: u64,
-    /// CI mode: 2 runs at 9 dB only.
+    /// CI mode: small defaults (2 runs at 9 dB only); never overrides a value given.
     #[arg(long)]
     pub quick: bool,
     /// Two-frame birth velocity (m/s, `pair_max_speed`): a birth particle's tangential
     /// velocity from its displacement to a birth cell of the frame before, when the
-    /// speed is at most this; 0 (default) = off, `N(0, 40^2)` tangential velocity.
+    /// speed is at most this, finite and >= 0; 0 (default) = off, `N(0, 40^2)` tangential
+    /// velocity.
     #[arg(long, default_value_t = 0.0)]
     pub birth_pair_speed: f64,
     /// At most this many particles move in the swarm per frame (0 = every gated
     /// particle, the setting of the README's earlier tables); default: the preset's 512.
     #[arg(long)]
     pub swarm_cap: Option<usize>,
+}
+
+impl Args {
+    /// The SNRs and runs after the `--quick` defaults, with every argument checked.
+    fn effective(&self) -> Result<(Vec<f64>, usize)> {
+        let q = self.quick;
+        let speed = cli::finite("--birth-pair-speed", self.birth_pair_speed)?;
+        anyhow::ensure!(
+            speed >= 0.0,
+            "--birth-pair-speed must be a speed >= 0 m/s, got {speed}"
+        );
+        let snrs =
+            self.snr_db
+                .clone()
+                .unwrap_or_else(|| if q { vec![9.0] } else { vec![9.0, 7.0, 5.0] });
+        anyhow::ensure!(!snrs.is_empty(), "--snr-db needs at least one value");
+        for &s in &snrs {
+            cli::snr_db("--snr-db", s)?;
+        }
+        let runs = cli::runs("--runs", self.runs.unwrap_or(if q { 2 } else { 100 }))?;
+        Ok((snrs, runs))
+    }
+
+    /// Checks every argument (one-line errors naming the argument) before any run.
+    pub fn validate(&self) -> Result<()> {
+        self.effective().map(|_| ())
+    }
 }
 
 /// The paper's numbers: (Table 2 PHD-TBD, Table 2 PSO, Table 3 x3, Table 4 PHD, PSO-DBSCAN).
@@ -139,20 +168,8 @@ fn mean_std(v: &[f64]) -> (f64, f64) {
 
 /// Runs the reproduction.
 pub fn run(args: &Args) -> Result<()> {
-    if !(args.birth_pair_speed.is_finite() && args.birth_pair_speed >= 0.0) {
-        anyhow::bail!(
-            "--birth-pair-speed must be a finite speed >= 0 m/s, got {}",
-            args.birth_pair_speed
-        );
-    }
-    if let Some(bad) = args.snr_db.iter().find(|s| !s.is_finite()) {
-        anyhow::bail!("--snr-db values must be finite, got {bad}");
-    }
-    let (snrs, runs) = if args.quick {
-        (vec![9.0], 2)
-    } else {
-        (args.snr_db.clone(), args.runs.max(1))
-    };
+    let (snrs, runs) = args.effective()?;
+    cli::out_dir(&args.out)?;
     // The host filter holds ~5 MB of fixed arrays: run trials on threads with big stacks.
     let pool = rayon::ThreadPoolBuilder::new()
         .stack_size(256 << 20)

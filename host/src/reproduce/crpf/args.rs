@@ -3,9 +3,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::{ensure, Context, Result};
+use anyhow::{ensure, Result};
 
 use super::evaluation::{ComparatorModel, Likelihood, VarSource};
+use crate::cli;
 use crate::scenario::crpf::{Noise, Othr};
 use faint_core::model::doppler::Window;
 
@@ -28,43 +29,48 @@ impl From<SceneWindow> for Window {
     }
 }
 
-/// Command-line arguments of `faint reproduce crpf`.
+/// Command-line arguments of `faint reproduce crpf`. `--quick` changes the defaults of
+/// the arguments not given, never a given value.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
-    /// Particles per detector (1000, 2000, 4000, 6000; 100, 250, 500 for quick runs).
-    #[arg(long, default_value_t = 1000)]
-    pub particles: usize,
-    /// H1 runs per SNR point.
-    #[arg(long, default_value_t = 1000)]
-    pub trials: usize,
+    /// Particles per detector: 100, 250, 500, 1000, 2000, 4000 or 6000 [default: 1000;
+    /// --quick: 100].
+    #[arg(long)]
+    pub particles: Option<usize>,
+    /// H1 runs per SNR point, 1 to 1000000 [default: 1000; --quick: 60].
+    #[arg(long)]
+    pub trials: Option<usize>,
     /// H0 runs for the thresholds (half set the threshold, half check it; all of them
-    /// set the threshold used for Pd).
-    #[arg(long, default_value_t = 20_000)]
-    pub h0_trials: usize,
-    /// Target false-alarm probability.
-    #[arg(long, default_value_t = 0.001)]
-    pub pfa: f64,
+    /// set the threshold used for Pd), at least 2 / pfa, at most 1000000 [default: 20000;
+    /// --quick: 400].
+    #[arg(long)]
+    pub h0_trials: Option<usize>,
+    /// Target false-alarm probability, in (0, 1) [default: 0.001; --quick: 0.05].
+    #[arg(long)]
+    pub pfa: Option<f64>,
     /// Background noise.
     #[arg(long, value_enum, default_value_t = Noise::Gaussian)]
     pub noise: Noise,
-    /// SNR grid `a:b:step` in dB (eq. 18).
-    #[arg(long, default_value = "-2:14:2")]
-    pub snr_db: String,
+    /// SNR grid `a:b:step` in dB (eq. 18), values in [-60, 60], at most 1000 points
+    /// [default: -2:14:2; --quick: 0:16:4].
+    #[arg(long, allow_hyphen_values = true)]
+    pub snr_db: Option<String>,
     /// Output directory.
     #[arg(long, default_value = "out/crpf")]
     pub out: PathBuf,
     /// Master seed.
     #[arg(long, default_value_t = 2017)]
     pub seed: u64,
-    /// Run the r_th and lambda sweeps of Fig. 5 (CRPF only, Gaussian noise, SNR 5 dB).
+    /// Run the r_th and lambda sweeps of Fig. 5 (CRPF only, Gaussian noise, SNR 5 dB;
+    /// always on with --quick).
     #[arg(long)]
     pub sweeps: bool,
-    /// H0 runs per sweep configuration.
-    #[arg(long, default_value_t = 4000)]
-    pub sweep_h0_trials: usize,
-    /// H1 runs per sweep configuration.
-    #[arg(long, default_value_t = 500)]
-    pub sweep_trials: usize,
+    /// H0 runs per sweep configuration, 11 to 1000000 [default: 4000; --quick: 200].
+    #[arg(long)]
+    pub sweep_h0_trials: Option<usize>,
+    /// H1 runs per sweep configuration, 1 to 1000000 [default: 500; --quick: 40].
+    #[arg(long)]
+    pub sweep_trials: Option<usize>,
     /// Per-bin noise variance of the Gaussian comparators: estimated from the run's
     /// frames (`run`, the preset) or the scene's true value (`true`).
     #[arg(long, value_enum, default_value_t = VarSource::Run)]
@@ -77,31 +83,105 @@ pub struct Args {
     /// Analysis window of the scene and of every detector's model.
     #[arg(long, value_enum, default_value_t = SceneWindow::Hamming)]
     pub window: SceneWindow,
-    /// Small preset for CI: N = 100, 60 H1 runs per point, 400 H0 runs, Pfa 0.05,
-    /// SNR 0:16:4, sweeps with 200 + 40 runs.
+    /// Small defaults for CI: N = 100, 60 H1 runs per point, 400 H0 runs, Pfa 0.05,
+    /// SNR 0:16:4, sweeps with 200 + 40 runs; never overrides a value given.
     #[arg(long)]
     pub quick: bool,
 }
 
+/// The arguments after the `--quick` defaults, checked.
+#[derive(Debug, Clone)]
+pub(super) struct Settings {
+    pub(super) particles: usize,
+    pub(super) trials: usize,
+    pub(super) h0_trials: usize,
+    pub(super) pfa: f64,
+    pub(super) noise: Noise,
+    pub(super) snr_db: String,
+    pub(super) grid: Vec<f64>,
+    pub(super) out: PathBuf,
+    pub(super) seed: u64,
+    pub(super) sweeps: bool,
+    pub(super) sweep_h0_trials: usize,
+    pub(super) sweep_trials: usize,
+    pub(super) comparator_var: VarSource,
+    pub(super) comparator_likelihood: Likelihood,
+    pub(super) window: SceneWindow,
+}
+
 impl Args {
-    /// The arguments with the `--quick` preset applied.
-    pub(super) fn effective(&self) -> Args {
-        let mut a = self.clone();
-        if a.quick {
-            a.particles = 100;
-            a.trials = 60;
-            a.h0_trials = 400;
-            a.pfa = 0.05;
-            a.snr_db = "0:16:4".into();
-            a.sweeps = true;
-            a.sweep_h0_trials = 200;
-            a.sweep_trials = 40;
+    /// The arguments with the `--quick` defaults applied, after [`validate`](Self::validate).
+    pub(super) fn effective(&self) -> Result<Settings> {
+        let q = self.quick;
+        let pfa = cli::probability("--pfa", self.pfa.unwrap_or(if q { 0.05 } else { 0.001 }))?;
+        let particles = self.particles.unwrap_or(if q { 100 } else { 1000 });
+        ensure!(
+            PARTICLES.contains(&particles),
+            "--particles {particles} is not supported (use {PARTICLES:?})"
+        );
+        let trials = cli::runs("--trials", self.trials.unwrap_or(if q { 60 } else { 1000 }))?;
+        let h0_trials = cli::runs(
+            "--h0-trials",
+            self.h0_trials.unwrap_or(if q { 400 } else { 20_000 }),
+        )?;
+        let need = 2 * (1.0 / pfa).ceil() as usize;
+        ensure!(
+            h0_trials >= need,
+            "--h0-trials {h0_trials} cannot resolve --pfa {pfa}: the threshold is checked on an \
+             independent half of the H0 runs, so each half needs at least {} runs \
+             (use --h0-trials {need} or more)",
+            need / 2,
+        );
+        let snr_db = self
+            .snr_db
+            .clone()
+            .unwrap_or_else(|| if q { "0:16:4" } else { "-2:14:2" }.into());
+        let grid = cli::grid("--snr-db", &snr_db)?;
+        for &s in &grid {
+            cli::snr_db("--snr-db", s)?;
         }
-        a
+        let sweeps = self.sweeps || q;
+        let sweep_h0_trials = cli::count(
+            "--sweep-h0-trials",
+            self.sweep_h0_trials.unwrap_or(if q { 200 } else { 4000 }),
+            11..=cli::MAX_RUNS,
+        )?;
+        let sweep_trials = cli::runs(
+            "--sweep-trials",
+            self.sweep_trials.unwrap_or(if q { 40 } else { 500 }),
+        )?;
+        Ok(Settings {
+            particles,
+            trials,
+            h0_trials,
+            pfa,
+            noise: self.noise,
+            snr_db,
+            grid,
+            out: self.out.clone(),
+            seed: self.seed,
+            sweeps,
+            sweep_h0_trials,
+            sweep_trials,
+            comparator_var: self.comparator_var,
+            comparator_likelihood: self.comparator_likelihood,
+            window: self.window,
+        })
     }
 
+    /// Checks every argument before any work is done (so a bad combination fails at
+    /// once, not after the H0 runs): `--pfa` in `(0, 1)`; a supported `--particles`;
+    /// run counts in `1..=1000000`; enough `--h0-trials` that the calibration's halves
+    /// resolve `--pfa` (each half must hold at least `1 / pfa` runs); a valid `--snr-db`
+    /// grid; more than 10 sweep H0 runs.
+    pub fn validate(&self) -> Result<()> {
+        self.effective().map(|_| ())
+    }
+}
+
+impl Settings {
     /// The comparators' noise model for scene `sc`.
-    pub fn comparator_model(&self, sc: &Othr) -> ComparatorModel {
+    pub(super) fn comparator_model(&self, sc: &Othr) -> ComparatorModel {
         ComparatorModel {
             var: self.comparator_var,
             likelihood: self.comparator_likelihood,
@@ -111,7 +191,7 @@ impl Args {
 
     /// Output sub-directory: `<noise>_n<N>`, with `_var-true`, `_lik-window`, `_rect`
     /// for the non-preset comparator variance, likelihood and window.
-    pub fn tag(&self) -> String {
+    pub(super) fn tag(&self) -> String {
         let mut t = format!("{:?}_n{}", self.noise, self.particles).to_lowercase();
         if self.comparator_var == VarSource::True {
             t += "_var-true";
@@ -124,68 +204,7 @@ impl Args {
         }
         t
     }
-
-    /// Checks every argument before any work is done (so a bad combination fails at
-    /// once, not after the H0 runs): `--pfa` in `(0, 1)`; a supported `--particles`; at
-    /// least one H1 trial; enough `--h0-trials` that the calibration's halves resolve
-    /// `--pfa` (each half must hold at least `1 / pfa` runs); a valid `--snr-db` grid;
-    /// with `--sweeps`, more than 10 sweep H0 runs and at least one sweep H1 run.
-    pub fn validate(&self) -> Result<()> {
-        let a = self.effective();
-        ensure!(
-            a.pfa > 0.0 && a.pfa < 1.0,
-            "--pfa must lie in (0, 1), got {}",
-            a.pfa
-        );
-        ensure!(
-            PARTICLES.contains(&a.particles),
-            "--particles {} is not supported (use {:?})",
-            a.particles,
-            PARTICLES
-        );
-        ensure!(a.trials >= 1, "--trials must be at least 1");
-        let need = 2 * (1.0 / a.pfa).ceil() as usize;
-        ensure!(
-            a.h0_trials >= need,
-            "--h0-trials {} cannot resolve --pfa {}: the threshold is checked on an \
-             independent half of the H0 runs, so each half needs at least {} runs \
-             (use --h0-trials {} or more)",
-            a.h0_trials,
-            a.pfa,
-            need / 2,
-            need
-        );
-        parse_grid(&a.snr_db)?;
-        if a.sweeps {
-            ensure!(
-                a.sweep_h0_trials > 10,
-                "--sweep-h0-trials must be more than 10 (the sweeps' Pfa is at least \
-                 10 / sweep-h0-trials), got {}",
-                a.sweep_h0_trials
-            );
-            ensure!(a.sweep_trials >= 1, "--sweep-trials must be at least 1");
-        }
-        Ok(())
-    }
 }
 
 /// Particle counts `faint reproduce crpf` is compiled for (see [`run_stats`](super::run_stats)).
 pub const PARTICLES: [usize; 7] = [100, 250, 500, 1000, 2000, 4000, 6000];
-
-/// Parses `a:b:step` into the grid `a, a + step, ..., <= b`.
-pub fn parse_grid(s: &str) -> Result<Vec<f64>> {
-    let p: Vec<f64> = s
-        .split(':')
-        .map(|x| x.trim().parse::<f64>())
-        .collect::<std::result::Result<_, _>>()
-        .with_context(|| format!("SNR grid '{s}' is not a:b:step"))?;
-    ensure!(p.len() == 3, "SNR grid '{s}' is not a:b:step");
-    let (a, b, st) = (p[0], p[1], p[2]);
-    ensure!(
-        st > 0.0 && b >= a,
-        "SNR grid '{s}' needs step > 0 and b >= a"
-    );
-    let n = ((b - a) / st + 1e-9).floor() as usize + 1;
-    ensure!(n <= 1000, "SNR grid '{s}' has too many points");
-    Ok((0..n).map(|i| a + i as f64 * st).collect())
-}

@@ -6,7 +6,7 @@
 use anyhow::Result;
 use serde::Serialize;
 
-use super::args::Args;
+use super::args::Settings;
 use super::evaluation::{Stats, METHODS};
 use crate::scenario::crpf::Noise;
 use crate::stats::detection::{detection_rate, threshold_at_pfa, Proportion, Threshold};
@@ -54,7 +54,7 @@ pub fn calibration(h0: &[f64], pfa: f64) -> Result<(Threshold, Proportion)> {
 
 /// Thresholds at `a.pfa` from the H0 statistics `h0`, with the calibration check of each
 /// compared statistic.
-pub(super) fn thresholds(a: &Args, h0: &[Stats]) -> Result<Thresholds> {
+pub(super) fn thresholds(a: &Settings, h0: &[Stats]) -> Result<Thresholds> {
     let mut thresholds = [0.0f64; 5];
     let mut cal_rows = Vec::new();
     for (m, name) in METHODS.iter().enumerate() {

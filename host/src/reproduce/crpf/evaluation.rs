@@ -15,7 +15,7 @@ use faint_core::statistic::{d_k, zeta_k};
 use faint_core::Complex32;
 use serde::Serialize;
 
-use super::args::Args;
+use super::args::Settings;
 use crate::montecarlo::run_trials;
 use crate::scenario::crpf::{Noise, Othr, Run};
 use crate::stats::detection::{detection_rate, snr_at_pd, threshold_at_pfa, PdPoint};
@@ -337,7 +337,7 @@ pub(super) struct PdCurves {
 
 /// H1 runs at every SNR of `grid`, each statistic against its threshold in `thresholds`.
 pub(super) fn pd_vs_snr(
-    a: &Args,
+    a: &Settings,
     sc: &Othr,
     cfg: &CrpfConfig,
     grid: &[f64],
@@ -395,7 +395,7 @@ pub(super) fn pd_vs_snr(
 }
 
 /// SNR at Pd = 0.5 and 0.9 of each compared statistic, and its difference to CRPF-max.
-pub(super) fn snr_at_pd_rows(a: &Args, curves: &[Vec<PdPoint>]) -> Vec<SnrRow> {
+pub(super) fn snr_at_pd_rows(a: &Settings, curves: &[Vec<PdPoint>]) -> Vec<SnrRow> {
     let mut snr_rows = Vec::new();
     for level in [0.5, 0.9] {
         let reference = snr_at_pd(&curves[0], level).snr_db;
@@ -432,7 +432,7 @@ pub(super) struct Sweeps {
 }
 
 /// Fig. 5: Pd of CRPF-max and CRPF-mean at 5 dB (Gaussian) over `r_th` and `lambda`.
-pub(super) fn sweeps(a: &Args, sc: &Othr, base: &CrpfConfig) -> Result<Sweeps> {
+pub(super) fn sweeps(a: &Settings, sc: &Othr, base: &CrpfConfig) -> Result<Sweeps> {
     let pfa = a.pfa.max(10.0 / a.sweep_h0_trials as f64);
     let mut rows = Vec::new();
     let mut series = vec![Vec::new(); 4];

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use super::args::Args;
+use super::args::Settings;
 use super::calibration::Thresholds;
 use super::evaluation::{PdCurves, SnrRow, Stats, Sweeps, METHODS};
 use crate::io::{self, plot};
@@ -14,7 +14,7 @@ use crate::scenario::crpf::Noise;
 
 /// H0 outputs: `h0_stats.csv`, `calibration.csv` and Fig. 1 (H0 histograms of the
 /// existence statistics).
-pub(super) fn h0(dir: &Path, a: &Args, h0: &[Stats], th: &Thresholds) -> Result<()> {
+pub(super) fn h0(dir: &Path, a: &Settings, h0: &[Stats], th: &Thresholds) -> Result<()> {
     io::write_csv(dir.join("h0_stats.csv"), h0)?;
     io::write_csv(dir.join("calibration.csv"), &th.rows)?;
     // Fig. 1: H0 histograms of zeta_K and D_K.
@@ -37,7 +37,7 @@ pub(super) fn h0(dir: &Path, a: &Args, h0: &[Stats], th: &Thresholds) -> Result<
 }
 
 /// `pd_vs_snr.csv` and the Pd versus SNR figure (Fig. 2 for Gaussian noise, else Fig. 4).
-pub(super) fn pd_vs_snr(dir: &Path, a: &Args, pd: &PdCurves) -> Result<()> {
+pub(super) fn pd_vs_snr(dir: &Path, a: &Settings, pd: &PdCurves) -> Result<()> {
     io::write_csv(dir.join("pd_vs_snr.csv"), &pd.rows)?;
     let series: Vec<plot::Series> = METHODS
         .iter()
@@ -69,7 +69,7 @@ pub(super) fn pd_vs_snr(dir: &Path, a: &Args, pd: &PdCurves) -> Result<()> {
 /// Doppler error); returns the Markdown. `elapsed_s` is the run's wall-clock time so far.
 pub(super) fn table(
     dir: &Path,
-    a: &Args,
+    a: &Settings,
     snr_rows: &[SnrRow],
     th: &Thresholds,
     fd_err: &[(f64, f64, usize)],
@@ -146,7 +146,7 @@ pub(super) fn table(
 }
 
 /// Fig. 5 outputs under `sweeps_n<N>/`: `fig5_sweeps.csv`, `fig5_r_th.svg`, `fig5_lambda.svg`.
-pub(super) fn sweeps(a: &Args, sw: &Sweeps) -> Result<()> {
+pub(super) fn sweeps(a: &Settings, sw: &Sweeps) -> Result<()> {
     let dir = a.out.join(format!("sweeps_n{}", a.particles));
     io::write_csv(dir.join("fig5_sweeps.csv"), &sw.rows)?;
     let names = ["CRPF-max", "CRPF-mean"];

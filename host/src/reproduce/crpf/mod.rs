@@ -18,13 +18,13 @@ mod calibration;
 mod evaluation;
 mod figures;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use faint_core::detect::crpf::CrpfConfig;
 use faint_core::rng::derive_seed;
 
 use crate::scenario::crpf::Othr;
 
-pub use args::{parse_grid, Args, SceneWindow, PARTICLES};
+pub use args::{Args, SceneWindow, PARTICLES};
 pub use calibration::calibration;
 pub use evaluation::{
     batch, run_detector, run_stats, ComparatorModel, Comparators, Likelihood, Stats, VarSource,
@@ -33,9 +33,8 @@ pub use evaluation::{
 
 /// `faint reproduce crpf`.
 pub fn run(args: &Args) -> Result<()> {
-    args.validate()?;
-    let a = args.effective();
-    let grid = parse_grid(&a.snr_db)?;
+    let a = args.effective()?;
+    let grid = a.grid.clone();
     let sc = Othr {
         window: a.window.into(),
         ..Othr::default()
@@ -44,7 +43,7 @@ pub fn run(args: &Args) -> Result<()> {
     cfg.model.window = sc.window;
     let tag = a.tag();
     let dir = a.out.join(&tag);
-    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    crate::cli::out_dir(&dir)?;
     let t0 = std::time::Instant::now();
 
     // H0: thresholds and calibration.

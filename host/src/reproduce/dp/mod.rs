@@ -23,14 +23,14 @@
 
 use std::path::PathBuf;
 
-use anyhow::{ensure, Context, Result};
+use anyhow::{ensure, Result};
 use faint_core::detect::dp::{Method, Transition};
 use serde::Serialize;
 
 use crate::analysis::dp::track_thresholds;
+use crate::cli;
 use crate::io::{self, plot::Series};
 use crate::montecarlo::run_trials;
-use crate::reproduce::crpf::parse_grid;
 use crate::scenario::dp::{DimPoint, HISTORY, METHODS};
 use crate::stats::detection::{proportion, threshold_at_pfa, Proportion};
 
@@ -42,18 +42,18 @@ pub use eval::{noise_run, target_run, trace, track_error, Trace, Variant};
 /// Command-line arguments of `faint reproduce dp`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
-    /// Monte Carlo runs per SNR point and speed (default 100; --quick: 4).
+    /// Monte Carlo runs per SNR point and speed, 1 to 1000000 (default 100; --quick: 4).
     #[arg(long)]
     pub runs: Option<usize>,
-    /// SNR grid `a:b:step`, `SNR = a / sigma` linear (eq. 29) (default 1.6:2.5:0.1;
-    /// --quick 2.0:2.5:0.5).
-    #[arg(long)]
+    /// SNR grid `a:b:step`, `SNR = a / sigma` linear (eq. 29), values in [0, 100], at most
+    /// 1000 points (default 1.6:2.5:0.1; --quick 2.0:2.5:0.5).
+    #[arg(long, allow_hyphen_values = true)]
     pub snr: Option<String>,
     /// Target speeds in px/frame, 1 and/or 2 (default 1,2; --quick 1).
     #[arg(long, value_delimiter = ',')]
     pub speeds: Option<Vec<u8>>,
     /// Noise-only runs per speed for the image-level thresholds, and as many again for
-    /// their independent false-alarm check (default 2000; --quick 100).
+    /// their independent false-alarm check, 100 to 1000000 (default 2000; --quick 100).
     #[arg(long)]
     pub noise_runs: Option<usize>,
     /// Frames per run, at most 40 (default 40; --quick 10).
@@ -94,18 +94,14 @@ struct Effective {
 impl Args {
     fn effective(&self) -> Result<Effective> {
         let q = self.quick;
-        let runs = self.runs.unwrap_or(if q { 4 } else { 100 });
-        ensure!(runs >= 1, "--runs must be at least 1, got {runs}");
+        let runs = cli::runs("--runs", self.runs.unwrap_or(if q { 4 } else { 100 }))?;
         let grid = self
             .snr
             .clone()
             .unwrap_or_else(|| if q { "2.0:2.5:0.5" } else { "1.6:2.5:0.1" }.into());
-        let snrs = parse_grid(&grid).map_err(|e| anyhow::anyhow!("--snr: {e}"))?;
-        for s in &snrs {
-            ensure!(
-                (0.0..=100.0).contains(s),
-                "--snr values must lie in [0, 100] (a / sigma), got {s}"
-            );
+        let snrs = cli::grid("--snr", &grid)?;
+        for &s in &snrs {
+            cli::within("--snr", s, 0.0..=100.0, " (a / sigma)")?;
         }
         let speeds = self
             .speeds
@@ -119,16 +115,14 @@ impl Args {
             );
         }
         let noise_runs = self.noise_runs.unwrap_or(if q { 100 } else { 2000 });
-        ensure!(
-            noise_runs as f64 * PFA >= 1.0,
-            "--noise-runs must be at least {} to resolve P_FA = {PFA}, got {noise_runs}",
-            (1.0 / PFA).ceil()
-        );
+        // At least 1 / P_FA runs resolve P_FA.
+        cli::count(
+            "--noise-runs",
+            noise_runs,
+            (1.0 / PFA).ceil() as usize..=cli::MAX_RUNS,
+        )?;
         let frames = self.frames.unwrap_or(if q { 10 } else { HISTORY });
-        ensure!(
-            (1..=HISTORY).contains(&frames),
-            "--frames must lie in 1..={HISTORY}, got {frames}"
-        );
+        cli::count("--frames", frames, 1..=HISTORY)?;
         let transition = match self.transition.as_deref() {
             None => None,
             Some("gaussian") => Some(Transition::Gaussian),
@@ -702,7 +696,7 @@ pub fn run(args: &Args) -> Result<()> {
         ..DimPoint::default()
     };
     let d = &args.out;
-    std::fs::create_dir_all(d).with_context(|| format!("cannot create {}", d.display()))?;
+    cli::out_dir(d)?;
     let mut results = Vec::new();
     for &speed in &e.speeds {
         results.push(run_speed(&sc, &e, args.seed, speed)?);

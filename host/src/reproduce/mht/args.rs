@@ -7,20 +7,22 @@ use std::path::PathBuf;
 #[cfg(doc)]
 use super::calibration::calibrate;
 use super::calibration::proportion_ci;
+use crate::cli;
 
 /// Command-line arguments.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
-    /// Clutter plots per scan (repeatable).
+    /// Clutter plots per scan, each in (0, 2000] (repeatable).
     #[arg(long = "lambda", num_args = 1.., default_values_t = vec![80.0, 164.0, 237.0, 316.0, 398.0])]
     pub lambda: Vec<f32>,
-    /// Trials per lambda (with targets).
-    #[arg(long, default_value_t = 2000)]
-    pub trials: usize,
-    /// Clutter-only trials per lambda for the model-threshold check.
-    #[arg(long, default_value_t = 500)]
-    pub null_trials: usize,
-    /// Wanted whole-grid Pfa for the thresholds.
+    /// Trials per lambda (with targets), 1 to 1000000 [default: 2000; --quick: 20].
+    #[arg(long)]
+    pub trials: Option<usize>,
+    /// Clutter-only trials per lambda for the model-threshold check, 1 to 1000000
+    /// [default: 500; --quick: 20].
+    #[arg(long)]
+    pub null_trials: Option<usize>,
+    /// Wanted whole-grid Pfa for the thresholds, in (0, 1).
     #[arg(long, default_value_t = 1e-4)]
     pub pfa: f64,
     /// Master seed.
@@ -29,10 +31,12 @@ pub struct Args {
     /// Output folder.
     #[arg(long, default_value = "out/mht")]
     pub out: PathBuf,
-    /// Use this `gamma_1` for every lambda instead of the model's (e.g. the paper's 22).
+    /// Use this `gamma_1` (1 to 255) for every lambda instead of the model's (e.g. the
+    /// paper's 22).
     #[arg(long)]
     pub gamma1: Option<u8>,
-    /// CI size: 20 trials, 20 null trials.
+    /// CI size: 20 trials, 20 null trials, 200 calibration and 200 check periods;
+    /// never overrides a value given.
     #[arg(long)]
     pub quick: bool,
     /// Per-cell clutter law that sets `gamma_1`: `paper` (eq. 20-26 as published) or
@@ -45,19 +49,20 @@ pub struct Args {
     /// confirmed track meets `--pfa` by `--calib-rule`, see [`calibrate`]).
     #[arg(long, value_enum, default_value_t = GammaFrom::Model)]
     pub gamma_from: GammaFrom,
-    /// Clutter-only periods per lambda for `--gamma-from sim`.
-    #[arg(long, default_value_t = 20_000)]
-    pub calib_periods: usize,
-    /// Independent clutter-only periods per lambda that check the calibrated `gamma_1`
-    /// (0: no check).
-    #[arg(long, default_value_t = 10_000)]
-    pub calib_check: usize,
+    /// Clutter-only periods per lambda for `--gamma-from sim`, 1 to 1000000
+    /// [default: 20000; --quick: 200].
+    #[arg(long)]
+    pub calib_periods: Option<usize>,
+    /// Independent clutter-only periods per lambda that check the calibrated `gamma_1`,
+    /// 0 (no check) to 1000000 [default: 10000; --quick: 200].
+    #[arg(long)]
+    pub calib_check: Option<usize>,
     /// Calibration rule: `point` (estimated rate `k / T <= pfa`) or `upper` (the
     /// Clopper-Pearson 95 % interval's upper end `<= pfa`; needs `T >~ 3.7 / pfa`).
     #[arg(long, value_enum, default_value_t = CalibRule::Point)]
     pub calib_rule: CalibRule,
     /// Smallest candidate `gamma_1` of the calibration (candidates below it are not
-    /// simulated; a result at this floor is flagged).
+    /// simulated; a result at this floor is flagged), 1 to 255.
     #[arg(long, default_value_t = 3)]
     pub calib_min_gamma: u8,
 }
@@ -120,53 +125,53 @@ pub(super) struct Sizes {
 
 impl Args {
     /// Checks the arguments before any work is done (and warns when `--calib-rule upper`
-    /// cannot reach `--pfa` with the calibration periods); returns the run sizes.
+    /// cannot reach `--pfa` with the calibration periods); returns the run sizes after
+    /// the `--quick` defaults.
     pub(super) fn validate(&self) -> anyhow::Result<Sizes> {
         let args = self;
-        anyhow::ensure!(
-            args.pfa > 0.0 && args.pfa < 1.0,
-            "--pfa must lie in (0, 1), got {}",
-            args.pfa
-        );
-        anyhow::ensure!(args.trials > 0, "--trials must be at least 1");
+        let q = args.quick;
+        cli::probability("--pfa", args.pfa)?;
         anyhow::ensure!(!args.lambda.is_empty(), "give at least one --lambda");
         for &l in &args.lambda {
+            cli::finite("--lambda", l.into())?;
             anyhow::ensure!(
-                l.is_finite() && l > 0.0 && l <= 2000.0,
+                l > 0.0 && l <= 2000.0,
                 "--lambda must lie in (0, 2000] clutter plots per scan, got {l}"
             );
         }
         if let Some(g) = args.gamma1 {
-            anyhow::ensure!(g >= 1, "--gamma1 must be at least 1");
+            cli::count("--gamma1", g.into(), 1..=255)?;
         }
+        cli::count("--calib-min-gamma", args.calib_min_gamma.into(), 1..=255)?;
         anyhow::ensure!(
             !(args.gamma1.is_some() && args.gamma_from == GammaFrom::Sim),
             "--gamma1 and --gamma-from sim exclude each other"
         );
-        let sizes = if args.quick {
-            Sizes {
-                trials: 20,
-                null_trials: 20,
-                calib_periods: 200,
-                calib_check: 200,
-            }
-        } else {
-            Sizes {
-                trials: args.trials,
-                null_trials: args.null_trials,
-                calib_periods: args.calib_periods,
-                calib_check: args.calib_check,
-            }
+        let sizes = Sizes {
+            trials: cli::runs("--trials", args.trials.unwrap_or(if q { 20 } else { 2000 }))?,
+            null_trials: cli::runs(
+                "--null-trials",
+                args.null_trials.unwrap_or(if q { 20 } else { 500 }),
+            )?,
+            calib_periods: cli::runs(
+                "--calib-periods",
+                args.calib_periods.unwrap_or(if q { 200 } else { 20_000 }),
+            )?,
+            calib_check: cli::count(
+                "--calib-check",
+                args.calib_check.unwrap_or(if q { 200 } else { 10_000 }),
+                0..=cli::MAX_RUNS,
+            )?,
         };
         let calib_periods = sizes.calib_periods;
-        if args.gamma_from == GammaFrom::Sim {
-            anyhow::ensure!(calib_periods > 0, "--calib-periods must be at least 1");
-            if args.calib_rule == CalibRule::Upper && (calib_periods as f64) * args.pfa < 3.7 {
-                eprintln!(
-                    "warning: --calib-rule upper with {calib_periods} periods cannot reach pfa {} (zero events give an upper bound ~3.7 / T): gamma_1 will be N + 1",
-                    args.pfa
-                );
-            }
+        if args.gamma_from == GammaFrom::Sim
+            && args.calib_rule == CalibRule::Upper
+            && (calib_periods as f64) * args.pfa < 3.7
+        {
+            eprintln!(
+                "warning: --calib-rule upper with {calib_periods} periods cannot reach pfa {} (zero events give an upper bound ~3.7 / T): gamma_1 will be N + 1",
+                args.pfa
+            );
         }
         Ok(sizes)
     }

@@ -2,7 +2,6 @@
 //! (trials, summary, clutter-only Pfa, calibration), the Monte Carlo Fig. 10-12 and the
 //! grid-Pfa chart, and `summary.md`, the Markdown summary also printed.
 
-use std::io::Write as _;
 use std::path::Path;
 
 use super::args::{Args, GammaFrom, Sizes};
@@ -328,7 +327,6 @@ pub(super) fn summary_md(
     }
     md += "\nModel (paper parameters, Fig. 2-4 set):\n\n";
     md += model_md;
-    let mut f = std::fs::File::create(args.out.join("summary.md"))?;
-    f.write_all(md.as_bytes())?;
+    crate::io::write_text(args.out.join("summary.md"), &md)?;
     Ok(md)
 }

@@ -46,7 +46,7 @@ pub use stages::{attribute, stage3_fates, Fate, Loss, StageReport};
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let sizes = args.validate()?;
     let mut calib_csv = Vec::new();
-    std::fs::create_dir_all(&args.out)?;
+    crate::cli::out_dir(&args.out)?;
     let model_md = figures::model_figures(&args.out)?;
     let mut summaries = Vec::new();
     let mut null_rows = Vec::new();
