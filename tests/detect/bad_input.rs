@@ -262,7 +262,10 @@ fn bad_numbers_name_the_argument_and_value() {
             "--gospa-c NaN: must be finite and > 0",
         ),
         (vec!["--min-score", "nan"], "--min-score: must be a number"),
-        (vec!["--gospa-c", "-1"], "--gospa-c -1: must be finite and > 0"),
+        (
+            vec!["--gospa-c", "-1"],
+            "--gospa-c -1: must be finite and > 0",
+        ),
     ] {
         let mut all = vec!["detect", "crpf", "--input", input];
         all.extend(args);
