@@ -39,6 +39,10 @@ enum Command {
     Detect(DetectArgs),
     /// Write a preset's frames in the format `faint detect` reads, with a truth file.
     Simulate(SimulateArgs),
+    /// Drive detectors with mutated configurations and hostile frames; write the findings.
+    Fuzz(faint::host::reliability::cli::FuzzArgs),
+    /// Stream plausible frames through detectors without reset; report cost drift and memory.
+    Soak(faint::host::reliability::cli::SoakArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -167,6 +171,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             );
             Ok(())
         }
+        Command::Fuzz(a) => faint::host::reliability::cli::fuzz_command(&a),
+        Command::Soak(a) => faint::host::reliability::cli::soak_command(&a),
         Command::Reproduce(r) => match r {
             Reproduce::Crpf(a) => faint::host::reproduce::crpf::run(&a),
             Reproduce::Mht(a) => faint::host::reproduce::mht::run(&a),

@@ -37,6 +37,8 @@ pub enum Error {
     IndexOutOfRange,
     /// Ancestor indices must be sorted ascending for the in-place gather.
     UnsortedAncestors,
+    /// Every value is finite but a sum of them overflows `f32` (e.g. a frame's energy).
+    Overflow,
 }
 
 impl fmt::Display for Error {
@@ -56,6 +58,7 @@ impl fmt::Display for Error {
             Error::Empty => f.write_str("input is empty"),
             Error::IndexOutOfRange => f.write_str("index out of range for the index type"),
             Error::UnsortedAncestors => f.write_str("ancestor indices are not sorted"),
+            Error::Overflow => f.write_str("values are finite but their sum overflows f32"),
         }
     }
 }

@@ -13,6 +13,7 @@
 //! - [`detect`]: every detector on a user's files, behind `faint detect <name>`.
 //! - [`timing`]: this thread's CPU time, for measurements on a shared machine.
 //! - [`cli`]: checks and parsers of command-line values shared by every command.
+//! - [`reliability`]: fuzz and soak campaigns over every detector (`faint fuzz`, `faint soak`).
 //! - [`simulate`]: a preset's frames and truth as files, behind `faint simulate <scenario>`.
 
 #![warn(missing_docs)]
@@ -22,6 +23,7 @@ pub mod cli;
 pub mod detect;
 pub mod io;
 pub mod montecarlo;
+pub mod reliability;
 pub mod reproduce;
 pub mod scenario;
 pub mod simulate;

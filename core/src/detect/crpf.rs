@@ -65,8 +65,8 @@ use crate::detect::{Detection, Detector, ScoreKind, Validate};
 use crate::existence::{BirthGaps, ExistenceDraw};
 use crate::math::{self, KahanSum};
 use crate::model::doppler::{
-    check_frame, DopplerReport, Model, ModelConfig, Motion, ProjectionCache, DOPPLER_STATE,
-    MAX_BINS,
+    check_frame, finite_estimate, DopplerReport, Model, ModelConfig, Motion, ProjectionCache,
+    DOPPLER_STATE, MAX_BINS,
 };
 use crate::particles::{gather_flagged, resample, systematic_with_sum, FlaggedState, Scheme};
 use crate::rng::Rng;
@@ -149,14 +149,25 @@ impl CrpfConfig {
         if !(0.0..=1.0).contains(&self.r_th) {
             return Err(Error::InvalidConfig("correlation threshold r_th"));
         }
+        let model = self.model.build()?;
+        // At most one band width, one alias-free Doppler rate and the largest amplitude.
+        let w = model.motion.band_width();
+        let limits = [
+            w,
+            w / model.motion.dt,
+            crate::model::doppler::max_amplitude(self.model.bins),
+        ];
         if self
             .jitter_std
             .iter()
-            .any(|s| !(s.is_finite() && *s >= 0.0))
+            .zip(limits)
+            .any(|(s, l)| !(s.is_finite() && *s >= 0.0 && *s <= l))
         {
-            return Err(Error::InvalidConfig("jitter std"));
+            return Err(Error::InvalidConfig(
+                "jitter std (at most W, W / dT, 1e18 / m)",
+            ));
         }
-        self.model.build()
+        Ok(model)
     }
 }
 
@@ -832,8 +843,8 @@ impl<const N: usize> CrpfTbd<N> {
             frame: self.frame,
             existence: count as f32 / N as f32,
             log_lr: 0.0,
-            estimate: mean,
-            min_cost_estimate: min,
+            estimate: finite_estimate(mean),
+            min_cost_estimate: finite_estimate(min),
         };
         Ok(self.last)
     }

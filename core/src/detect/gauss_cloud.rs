@@ -276,7 +276,7 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
             frame: self.frame,
             existence,
             log_lr,
-            estimate: est,
+            estimate: crate::model::doppler::finite_estimate(est),
             min_cost_estimate: None,
         };
         self.last

@@ -50,7 +50,8 @@ impl<const N: usize> PfLrt<N> {
             Some(lse) => lse - math::ln(N as f32),
             None => 0.0,
         };
-        self.log_lr += inc;
+        // Saturates at +-f32::MAX (a long run with a tiny noise variance reaches it).
+        self.log_lr = (self.log_lr + inc).clamp(-f32::MAX, f32::MAX);
         let evidence = if inc < -80.0 {
             0.0
         } else {

@@ -37,8 +37,9 @@
 //!    stable id (given at birth) and its age in frames.
 //!
 //! Bad input: a map of the wrong size, NaN/inf or negative pixels are typed errors before
-//! any state change; a component whose likelihoods all underflow, or whose existence
-//! falls below `prune_below`, is dropped (no NaN: existences stay in `[0, 1]`).
+//! any state change; a component whose likelihoods all underflow, whose estimate is not
+//! finite (particles beyond the range of `f32`), or whose existence falls below
+//! `prune_below`, is dropped (no NaN: existences stay in `[0, 1]`).
 
 #![allow(clippy::needless_range_loop)]
 
@@ -711,6 +712,13 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
             };
             c.r = updated_existence(c.r, ln_rho);
             c.est = estimate(x, w, false);
+            if !c.est.iter().all(|v| v.is_finite()) {
+                // The particles left the range of f32 (a configuration at the edge of
+                // it, e.g. a huge frame interval): the component dies (no NaN reported).
+                c.live = false;
+                rep.pruned += 1;
+                continue;
+            }
             c.age = c.age.saturating_add(1);
             // Resample to L = clamp(round(r L_max), L_min, L_max).
             let l = (math::round(c.r * cfg.max_particles as f32) as usize)

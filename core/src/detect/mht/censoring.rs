@@ -64,8 +64,12 @@ impl<const P: usize> Default for Censor<P> {
 }
 
 impl<const P: usize> Censor<P> {
+    /// Compile-time check: plot indices fit the `u16` order and pair lists.
+    const SHAPE: () = assert!(P <= u16::MAX as usize, "at most 65535 plots per scan");
+
     /// Empty working memory.
     pub const fn new() -> Self {
+        let () = Self::SHAPE;
         Self {
             order: [[0; P]; 2],
             pairs: [[(0, 0); P]; MAX_M],
@@ -78,7 +82,10 @@ impl<const P: usize> Censor<P> {
     /// scan `s-1`, then, when `s >= m-1`, the chains of the window `s-m+1..=s`, marking
     /// the plots of every collinear chain effective in `flags`.
     ///
-    /// `m` must be in `3..=MAX_M` and `gate >= 0` (checked by the config).
+    /// `m` is in `3..=MAX_M` and `gate >= 0` for a config that validates; any other `m`,
+    /// a NaN gate, or fewer than `s + 1` rows of `flags` finds nothing (empty stats,
+    /// `flags` untouched). Pairs found on earlier calls refer to the plots of the same
+    /// `scans`; a chain whose plot is no longer there is skipped.
     pub fn step<const R: usize, const A: usize>(
         &mut self,
         geom: &Geometry<R, A>,
@@ -88,7 +95,11 @@ impl<const P: usize> Censor<P> {
         m: usize,
         gate: f32,
     ) -> CensorStats {
+        let () = Self::SHAPE;
         let mut st = CensorStats::default();
+        if !(3..=MAX_M).contains(&m) || gate.is_nan() || flags.len() <= s {
+            return st;
+        }
         let Some(cur) = scans.get(s) else {
             return st;
         };
@@ -181,18 +192,34 @@ impl<const P: usize> Censor<P> {
                 return;
             }
             *budget -= 1;
+            let flag = |flags: &[[u8; P]], j: usize| {
+                flags
+                    .get(s0 + j)
+                    .and_then(|row| row.get(usize::from(chain[j])))
+                    .copied()
+            };
             // all already effective: nothing to learn
-            if (0..m).all(|j| flags[s0 + j][usize::from(chain[j])] & FLAG_EFFECTIVE != 0) {
+            if (0..m).all(|j| flag(flags, j).is_none_or(|f| f & FLAG_EFFECTIVE != 0)) {
                 return;
             }
             st.chains += 1;
             for j in 0..m {
-                let p = scans[s0 + j][usize::from(chain[j])];
+                let Some(p) = scans
+                    .get(s0 + j)
+                    .and_then(|sc| sc.get(usize::from(chain[j])))
+                else {
+                    return;
+                };
                 pts[j] = geom.quantise(p.x, p.y);
             }
             if geom.share_cell(&pts[..m]) {
                 for j in 0..m {
-                    let f = &mut flags[s0 + j][usize::from(chain[j])];
+                    let Some(f) = flags
+                        .get_mut(s0 + j)
+                        .and_then(|row| row.get_mut(usize::from(chain[j])))
+                    else {
+                        continue;
+                    };
                     if *f & FLAG_EFFECTIVE == 0 {
                         *f |= FLAG_EFFECTIVE;
                         st.newly_effective += 1;

@@ -18,7 +18,7 @@ use crate::{Error, Result};
     serde(deny_unknown_fields)
 )]
 pub struct ClassicHoughConfig {
-    /// Surveillance area `[x_min, x_max, y_min, y_max]` (m).
+    /// Surveillance area `[x_min, x_max, y_min, y_max]` (m), `|coordinates| <= 1e18`.
     pub area: [f32; 4],
     /// Scans per integration period `N` (blocked periods).
     pub n_scans: usize,

@@ -41,9 +41,17 @@ pub struct Geometry<const R: usize, const A: usize> {
 }
 
 impl<const R: usize, const A: usize> Geometry<R, A> {
+    /// Compile-time check of the grid shape: at least one cell on each axis, and rho
+    /// cells addressable by the `u16` curves.
+    const SHAPE: () = assert!(
+        R > 0 && A > 0 && R <= u16::MAX as usize,
+        "a Hough grid needs 1..=65535 rho cells and at least one angle"
+    );
+
     /// An all-zero placeholder (for `static` detector storage); replace it with
     /// [`Geometry::new`] before use.
     pub const fn placeholder() -> Self {
+        let () = Self::SHAPE;
         Self {
             cos: [0.0; A],
             sin: [0.0; A],
@@ -65,6 +73,7 @@ impl<const R: usize, const A: usize> Geometry<R, A> {
     /// `rho_max` is floored at `1e-3` m (degenerate geometry: all points at the origin
     /// map to the middle rho cell) and non-finite inputs fall back to origin 0 and the floor.
     pub fn new(x0: f32, y0: f32, rho_max: f32) -> Self {
+        let () = Self::SHAPE;
         let mut cos = [0.0f32; A];
         let mut sin = [0.0f32; A];
         let mut cos_q = [0i32; A];
@@ -129,19 +138,23 @@ impl<const R: usize, const A: usize> Geometry<R, A> {
     pub fn theta(&self, a: usize) -> f32 {
         a as f32 * math::PI / A as f32
     }
-    /// `(cos theta_a, sin theta_a)`.
+    /// `(cos theta_a, sin theta_a)`; `(1, 0)` for an angle index `a >= A`.
     pub fn trig(&self, a: usize) -> (f32, f32) {
-        (self.cos[a % A], self.sin[a % A])
+        match (self.cos.get(a), self.sin.get(a)) {
+            (Some(&c), Some(&s)) => (c, s),
+            _ => (1.0, 0.0),
+        }
     }
     /// Centre of rho cell `r`.
     pub fn rho_center(&self, r: usize) -> f32 {
         -self.rho_max + (r as f32 + 0.5) * self.drho
     }
 
-    /// `rho` of `(x, y)` at angle `a` (f32).
+    /// `rho` of `(x, y)` at angle `a` (f32); the angle `theta_0 = 0` for `a >= A`.
     #[inline]
     pub fn rho(&self, x: f32, y: f32, a: usize) -> f32 {
-        (x - self.x0) * self.cos[a] + (y - self.y0) * self.sin[a]
+        let (c, s) = self.trig(a);
+        (x - self.x0) * c + (y - self.y0) * s
     }
 
     /// Rho cell of `(x, y)` at angle `a` (f32 quantiser), clamped to `0..R`.
@@ -173,9 +186,17 @@ impl<const R: usize, const A: usize> Geometry<R, A> {
     }
 
     /// Rho cell of integer coordinates at angle `a` (integer quantiser), in `0..R`.
+    /// Coordinates are those of [`quantise`](Self::quantise) (`|xq|, |yq| <= 32767`;
+    /// larger ones are clamped); the angle `theta_0 = 0` for `a >= A`.
     #[inline]
     pub fn rho_index_q(&self, xq: i32, yq: i32, a: usize) -> usize {
-        let acc = xq * self.cos_q[a] + yq * self.sin_q[a];
+        let (c, s) = match (self.cos_q.get(a), self.sin_q.get(a)) {
+            (Some(&c), Some(&s)) => (c, s),
+            _ => (TRIG_Q as i32, 0),
+        };
+        let (xq, yq) = (xq.clamp(-32767, 32767), yq.clamp(-32767, 32767));
+        // |acc| <= 2 * 32767 * 16384 < 2^31.
+        let acc = xq * c + yq * s;
         let u = (i64::from(acc) + self.rmax_q).max(0) as u64;
         (((u * self.mul_q) >> 32) as usize).min(R - 1)
     }

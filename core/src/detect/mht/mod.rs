@@ -57,8 +57,13 @@ pub fn in_area(p: &Plot, area: [f32; 4]) -> bool {
         && p.y <= area[3]
 }
 
+/// Largest coordinate magnitude of an area (m): the grid's half diagonal
+/// `sqrt(hx^2 + hy^2)` of eq. 7 then stays finite (`2 (1e18)^2 < f32::MAX`).
+pub const MAX_COORDINATE: f32 = 1e18;
+
 pub(crate) fn validate_area(area: [f32; 4]) -> Result<()> {
-    if area.iter().any(|v| !v.is_finite()) || area[1] <= area[0] || area[3] <= area[2] {
+    if area.iter().any(|v| !(v.abs() <= MAX_COORDINATE)) || area[1] <= area[0] || area[3] <= area[2]
+    {
         return Err(Error::InvalidConfig("area"));
     }
     Ok(())
@@ -72,7 +77,7 @@ pub(crate) fn validate_area(area: [f32; 4]) -> Result<()> {
     serde(deny_unknown_fields)
 )]
 pub struct MhtConfig {
-    /// Surveillance area `[x_min, x_max, y_min, y_max]` (m).
+    /// Surveillance area `[x_min, x_max, y_min, y_max]` (m), `|coordinates| <= 1e18`.
     pub area: [f32; 4],
     /// Sliding-window length `M` (3..=8).
     pub m: usize,
@@ -81,7 +86,8 @@ pub struct MhtConfig {
     /// Velocity gate `V_max T_scan` (m), eq. 6.
     pub gate: f32,
     /// PeriodSummary threshold `gamma_1` on the binary-integration count of a cell (the
-    /// smoothing only locates the peak, see [`Accumulator::condense`]).
+    /// smoothing only locates the peak, see [`Accumulator::condense`]); `1..=n_scans`,
+    /// or `n_scans + 1` for no confirmation (periods are still integrated).
     pub gamma1: u8,
     /// Apply the 3x3 Gaussian smoothing to locate the peaks.
     pub smooth: bool,
@@ -146,7 +152,9 @@ impl Validate for MhtConfig {
         if !(self.gate.is_finite() && self.gate > 0.0) {
             return Err(Error::InvalidConfig("gate"));
         }
-        if self.gamma1 == 0 {
+        // A track has at most `n_scans` plots: `n_scans + 1` turns confirmation off
+        // (periods are still integrated, for `redetect`), anything larger is an error.
+        if self.gamma1 == 0 || usize::from(self.gamma1) > self.n_scans + 1 {
             return Err(Error::InvalidConfig("gamma1"));
         }
         if !(self.d_max.is_finite() && self.d_max > 0.0) {

@@ -57,6 +57,8 @@ pub struct Dbscan<const N: usize> {
     pub labels: [i32; N],
     queue: [u32; N],
     n_runs: usize,
+    /// A grid cell fits in the eps disc (see [`Dbscan::run`]).
+    shortcut: bool,
 }
 
 impl<const N: usize> Default for Dbscan<N> {
@@ -85,6 +87,7 @@ impl<const N: usize> Dbscan<N> {
             labels: [0; N],
             queue: [0; N],
             n_runs: 0,
+            shortcut: true,
         }
     }
 
@@ -120,7 +123,13 @@ impl<const N: usize> Dbscan<N> {
             return self.core[p] == 1;
         }
         let own = self.run_of[p] as usize;
-        let mut count = self.run_len[own] as usize;
+        // With the shortcut every point of the own cell is a neighbour; without it the
+        // own cell is searched like the others.
+        let (own, mut count) = if self.shortcut {
+            (own, self.run_len[own] as usize)
+        } else {
+            (usize::MAX, 0)
+        };
         if count < min_pts {
             let k = self.key[p];
             let (gx, gy) = ((k >> 32) as u32, k as u32);
@@ -168,24 +177,33 @@ impl<const N: usize> Dbscan<N> {
             return Ok(0);
         }
         let (mut minx, mut miny) = (f32::INFINITY, f32::INFINITY);
+        let (mut maxx, mut maxy) = (f32::NEG_INFINITY, f32::NEG_INFINITY);
         for p in pts {
             if !(p[0].is_finite() && p[1].is_finite()) {
                 return Err(Error::NonFinite);
             }
             minx = minx.min(p[0]);
             miny = miny.min(p[1]);
+            maxx = maxx.max(p[0]);
+            maxy = maxy.max(p[1]);
         }
-        let side = 0.7 * params.eps;
-        let eps2 = params.eps * params.eps;
-        let grid = |v: f32, lo: f32| -> Result<u32> {
-            let g = (v - lo) / side;
-            if g >= 4.0e9 {
-                return Err(Error::InvalidConfig("dbscan: point extent over 4e9 eps"));
-            }
-            Ok(g as u32)
+        // Half extents never overflow (`|a/2 - b/2| <= f32::MAX`). A grid of more than
+        // 2^31 cells per axis (points spread over more than ~1.5e9 eps) gets larger
+        // cells and loses the shortcuts that need a cell to fit in the eps disc; the
+        // clustering stays exact.
+        let half = |v: f32, lo: f32| 0.5 * v - 0.5 * lo;
+        let extent = half(maxx, minx).max(half(maxy, miny));
+        let side = (0.7 * params.eps).max(f32::MIN_POSITIVE);
+        let (half_side, shortcut) = if extent / (0.5 * side) < 2.0e9 {
+            (0.5 * side, true)
+        } else {
+            (extent / 2.0e9, false)
         };
+        self.shortcut = shortcut;
+        let eps2 = params.eps * params.eps;
+        let grid = |v: f32, lo: f32| -> u32 { (half(v, lo) / half_side) as u32 };
         for (i, p) in pts.iter().enumerate() {
-            self.key[i] = pack(grid(p[0], minx)?, grid(p[1], miny)?);
+            self.key[i] = pack(grid(p[0], minx), grid(p[1], miny));
             self.order[i] = i as u32;
             self.labels[i] = UNVISITED;
             self.core[i] = 0;
@@ -263,7 +281,7 @@ impl<const N: usize> Dbscan<N> {
                         }
                         let po = pts[o];
                         let (dx, dy) = (po[0] - pq[0], po[1] - pq[1]);
-                        if r == own || dx * dx + dy * dy <= eps2 {
+                        if (self.shortcut && r == own) || dx * dx + dy * dy <= eps2 {
                             self.labels[o] = id;
                             self.run_free[r] -= 1;
                             self.queue[qlen] = o as u32;

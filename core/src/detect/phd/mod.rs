@@ -19,7 +19,7 @@ pub mod smc_phd;
 
 pub use dbscan::{Dbscan, DbscanParams};
 pub use kmeans::KMeans;
-pub use pso::{PsoConfig, Swarm};
+pub use pso::{PsoConfig, Swarm, MAX_GENERATIONS};
 pub use smc_phd::{
     BirthComponent, BirthMode, BirthModel, Estimate, Extractor, PhdConfig, PhdReport, SmcPhdTbd,
     MAX_BIRTH_COMPONENTS,

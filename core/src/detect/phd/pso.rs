@@ -27,6 +27,11 @@ use crate::rng::Rng;
 
 const NONE: u32 = u32::MAX;
 
+/// Largest `generations` / `max_generations` a config validates with: a frame's swarm
+/// work is bounded (one generation of the preset's 512-particle swarm costs about 60 us
+/// on one host core, so the cap is about 0.06 s per frame; 1e5 generations took 6 s).
+pub const MAX_GENERATIONS: usize = 1000;
+
 /// Most active objectives a group sorted by the divide-and-conquer sort has (groups with
 /// more use ENS-BS, see [`Swarm::select`]).
 const DC_OBJECTIVES: usize = 4;
@@ -216,7 +221,8 @@ pub struct PsoConfig {
     /// below this, `Th_pso` (0.7).
     pub threshold: f32,
     /// Hard cap on generations per frame (ours: bounded work per frame; the paper has
-    /// none). Values below `generations` are treated as `generations`.
+    /// none). Values below `generations` are treated as `generations`. Both are at most
+    /// [`MAX_GENERATIONS`].
     pub max_generations: usize,
     /// `Z_m` at the local maximum of the frame's log likelihood ratio inside the chosen
     /// cell (sub-cell), instead of the cell centre.

@@ -58,7 +58,8 @@ pub use whiten::unwindow;
 
 use crate::{Complex32, Error, Result};
 
-/// Validates a frame: `m` bins, all finite. Returns `||z||^2`.
+/// Validates a frame: `m` bins, all finite ([`Error::NonFinite`]), with a finite energy
+/// ([`Error::Overflow`]). Returns `||z||^2`.
 pub fn check_frame(z: &[Complex32], m: usize) -> Result<f32> {
     if z.len() != m {
         return Err(Error::LengthMismatch {
@@ -74,7 +75,7 @@ pub fn check_frame(z: &[Complex32], m: usize) -> Result<f32> {
         zz += c.re * c.re + c.im * c.im;
     }
     if !zz.is_finite() {
-        return Err(Error::NonFinite);
+        return Err(Error::Overflow);
     }
     Ok(zz)
 }
@@ -82,7 +83,8 @@ pub fn check_frame(z: &[Complex32], m: usize) -> Result<f32> {
 /// Per-bin noise variance estimated from frames, `s2 = sum_k ||z_k||^2 / (K m)` (what the
 /// Gaussian comparators assume when the statistics are "unknown"; the paper estimates it
 /// from all K frames). Errors: [`Error::Empty`] for no frames, the errors of
-/// [`check_frame`], and [`Error::InvalidConfig`] if the estimate is zero (all-zero frames).
+/// [`check_frame`], [`Error::Overflow`] if the frames' total energy overflows, and
+/// [`Error::InvalidConfig`] if the estimate is zero (all-zero frames).
 pub fn estimate_noise_variance<'a>(
     frames: impl IntoIterator<Item = &'a [Complex32]>,
     m: usize,
@@ -95,6 +97,9 @@ pub fn estimate_noise_variance<'a>(
     }
     if k == 0 {
         return Err(Error::Empty);
+    }
+    if !total.is_finite() {
+        return Err(Error::Overflow);
     }
     let v = total / (k * m) as f32;
     if !(v.is_finite() && v > 0.0) {
@@ -169,6 +174,32 @@ impl ModelConfig {
             band: obs.band(),
         };
         motion.validate()?;
+        let (lo, hi) = motion.band;
+        let w = motion.band_width();
+        // Doppler is periodic in the band: a birth outside it is one of its aliases.
+        if !(self.prior.fd.0 >= lo && self.prior.fd.1 <= hi) {
+            return Err(Error::InvalidConfig("prior box Doppler (inside the band)"));
+        }
+        // A Doppler rate that moves more than one band width per frame is an alias too.
+        let fda_max = w / motion.dt;
+        if !(self.prior.fda.0 >= -fda_max && self.prior.fda.1 <= fda_max) {
+            return Err(Error::InvalidConfig(
+                "prior box Doppler rate (|fda| <= W / dT)",
+            ));
+        }
+        if !(self.prior.amp.1 <= max_amplitude(self.bins)) {
+            return Err(Error::InvalidConfig(
+                "prior box amplitude (at most 1e18 / m)",
+            ));
+        }
+        // One frame's process noise (std) at most the whole band / the largest amplitude.
+        if !(motion.dt * motion.dt * self.accel_std <= w
+            && motion.dt * self.amp_std <= max_amplitude(self.bins))
+        {
+            return Err(Error::InvalidConfig(
+                "process noise std (one frame within range)",
+            ));
+        }
         let chain = crate::existence::ExistenceMarkov::new(self.birth, self.death)?;
         Ok(Model {
             obs,
@@ -178,6 +209,13 @@ impl ModelConfig {
             initial_existence: self.initial_existence,
         })
     }
+}
+
+/// Largest amplitude of the prior box for `m` bins: `||h||^2 <= A^2 (sum w)^2 SPAN` with
+/// `sum w <= m`, and a cost `||z - h||^2` adds a few such terms, so `A <= 1e18 / m` keeps
+/// every cost below `f32::MAX` (`(1e18)^2 * 5 * 4 = 2e37`).
+pub fn max_amplitude(m: usize) -> f32 {
+    1e18 / m.max(1) as f32
 }
 
 /// A built [`ModelConfig`].
@@ -212,6 +250,14 @@ pub struct DopplerReport {
     pub estimate: Option<[f32; 3]>,
     /// Min-cost estimate (CRPF-TBD only, eq. 8).
     pub min_cost_estimate: Option<[f32; 3]>,
+}
+
+/// An estimate with every component finite, else `None`: the last guard of every
+/// Doppler-frame detector's report (a particle cloud that reached the edge of `f32`
+/// reports no estimate for that frame rather than a NaN).
+#[inline]
+pub(crate) fn finite_estimate(e: Option<[f32; 3]>) -> Option<[f32; 3]> {
+    e.filter(|x| x.iter().all(|v| v.is_finite()))
 }
 
 /// Names of the Doppler-frame state `[fd, fda, A]` ([`Detector::STATE`](crate::detect::Detector::STATE)).

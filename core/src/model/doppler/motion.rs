@@ -99,16 +99,40 @@ impl Motion {
         }
     }
 
-    /// Wraps a Doppler into the band.
+    /// Wraps a Doppler into the band: by one band width (the usual case), else by as many
+    /// as it takes (`fd - W floor((fd - lo) / W)`, kept inside `[lo, hi)`); NaN or
+    /// infinity becomes `lo`.
     #[inline]
     pub fn wrap(&self, fd: f32) -> f32 {
         let w = self.band.1 - self.band.0;
-        if fd >= self.band.1 {
+        let r = if fd >= self.band.1 {
             fd - w
         } else if fd < self.band.0 {
             fd + w
         } else {
-            fd
+            return fd;
+        };
+        if r >= self.band.0 && r < self.band.1 {
+            r
+        } else {
+            self.wrap_far(fd)
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn wrap_far(&self, fd: f32) -> f32 {
+        let (lo, hi) = self.band;
+        let w = hi - lo;
+        if !fd.is_finite() {
+            return lo;
+        }
+        let k = crate::math::floor((fd - lo) / w);
+        let r = fd - k * w;
+        if r >= lo && r < hi {
+            r
+        } else {
+            lo
         }
     }
 

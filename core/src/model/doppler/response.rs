@@ -258,7 +258,9 @@ impl DopplerModel {
             first += m;
         }
         if !(0..m).contains(&first) {
-            first = (b as i64 - HALF_SPAN as i64).rem_euclid(m as i64) as i32;
+            first = (b as i64)
+                .saturating_sub(HALF_SPAN as i64)
+                .rem_euclid(m as i64) as i32;
         }
         (first as usize, i0, frac)
     }

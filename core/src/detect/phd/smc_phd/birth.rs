@@ -199,7 +199,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             if h < 0.0 {
                 0
             } else {
-                (h as usize + 1).min(n)
+                (h as usize).saturating_add(1).min(n)
             }
         };
         let r0 = lo(c.range - dr, g.range_start, g.range_cell);

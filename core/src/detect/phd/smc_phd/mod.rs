@@ -156,6 +156,11 @@ impl Validate for PhdConfig {
             return Err(Error::InvalidConfig("particles_per_target / min_particles"));
         }
         if let Some(p) = &self.pso {
+            if p.generations > super::pso::MAX_GENERATIONS
+                || p.max_generations > super::pso::MAX_GENERATIONS
+            {
+                return Err(Error::InvalidConfig("pso generations (at most 1000)"));
+            }
             if p.points == 0
                 || p.max_members == 0
                 || !pos(p.fitness_scale)
@@ -170,8 +175,8 @@ impl Validate for PhdConfig {
         match &self.extractor {
             Extractor::Dbscan(p) => p.validate()?,
             Extractor::KMeans { max_iter } => {
-                if *max_iter == 0 {
-                    return Err(Error::InvalidConfig("kmeans max_iter"));
+                if *max_iter == 0 || *max_iter > super::pso::MAX_GENERATIONS {
+                    return Err(Error::InvalidConfig("kmeans max_iter (1..=1000)"));
                 }
             }
         }
@@ -209,6 +214,10 @@ pub struct PhdReport {
     /// Every weight underflowed to zero: the PHD is emptied and refilled by the next
     /// frame's births (documented recovery).
     pub degenerate: bool,
+    /// The extractor could not cluster the particles (a state that is not finite): no
+    /// estimates this frame, the filter itself is kept (documented recovery; the frame
+    /// is not an error because the filter has already taken it in).
+    pub extract_failed: bool,
 }
 
 /// The SMC-PHD TBD filter with capacities: `N` particles (survivors plus births), `S`
@@ -368,7 +377,10 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             self.n = 0;
         }
         report.particles = self.n;
-        self.extract(report.n_hat)?;
+        if self.extract(report.n_hat).is_err() {
+            self.n_est = 0;
+            report.extract_failed = true;
+        }
         self.choose_birth_cells(&cube);
         report.estimates = self.n_est;
         Ok(report)

@@ -1,0 +1,302 @@
+//! The detectors a campaign drives: every entry of `faint detect --list`, built with the
+//! host's capacities and the preset configuration, each with its frame generator.
+//!
+//! The PSO-PHD-TBD cube is shrunk for the campaign (30 x 30 x 20 cells over the preset's
+//! extent instead of 142 x 150 x 90) so that a case costs milliseconds; the arithmetic
+//! the campaign probes is the same at any size.
+
+use std::thread;
+
+use anyhow::{anyhow, bail, Context, Result};
+use faint_core::detect::bernoulli::BernoulliTbd;
+use faint_core::detect::cbmember::CbmemberConfig;
+use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint_core::detect::dp::{DpConfig, Method};
+use faint_core::detect::mht::MhtConfig;
+use faint_core::detect::pf_lrt::PfLrt;
+use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint_core::detect::phd::PhdConfig;
+use faint_core::detect::Detector;
+use faint_core::model::range_doppler::PointModel;
+use faint_core::rng::Rng;
+use serde::Serialize;
+use serde_json::Value;
+
+use super::frames::{complex, plots, reals, Mode};
+use super::soak::{soak, Soak};
+use super::{fuzz, Options, Tally, Target};
+use crate::detect::default_classic;
+use crate::reproduce::mht::{Classic, Mht, P as MHT_PLOTS};
+use crate::scenario::cbmember::HostFilter as CbmemberHost;
+use crate::scenario::dp::{self as sdp, SIDE};
+use crate::scenario::phd::{HostFilter as PhdHost, SixTargets, Variant};
+
+/// Particles of the particle-filter detectors in a campaign (the smallest host size).
+pub const PARTICLES: usize = 1000;
+
+/// Names of every detector a campaign can drive (those of `faint detect --list`).
+pub const NAMES: [&str; 14] = [
+    "crpf",
+    "pf-tbd",
+    "jott",
+    "pf-lrt",
+    "mht",
+    "hough-classic",
+    "phd-tbd",
+    "pso-phd-kmeans",
+    "pso-phd-dbscan",
+    "cbmember",
+    "cbmember-doppler",
+    "dp-arnold",
+    "dp-pulford",
+    "dp-second",
+];
+
+/// Largest frame a generator draws; a configuration asking for more gets wrong-length
+/// frames (what the detector must reject).
+const MAX_FRAME: usize = 1 << 22;
+
+fn to_value<C: Serialize>(c: &C) -> Value {
+    serde_json::to_value(c).unwrap_or(Value::Null)
+}
+
+fn len_or_short(n: Option<usize>) -> usize {
+    match n {
+        Some(n) if n <= MAX_FRAME => n,
+        _ => 16,
+    }
+}
+
+fn doppler_crpf(rng: &mut Rng, c: &CrpfConfig, mode: Mode) -> Vec<faint_core::Complex32> {
+    complex(rng, len_or_short(Some(c.model.bins)), mode, 1.0)
+}
+
+fn doppler_gauss(rng: &mut Rng, c: &GaussConfig, mode: Mode) -> Vec<faint_core::Complex32> {
+    complex(rng, len_or_short(Some(c.model.bins)), mode, 1.0)
+}
+
+fn scan_mht(rng: &mut Rng, c: &MhtConfig, mode: Mode) -> Vec<faint_core::model::plot::Plot> {
+    plots(rng, c.area, MHT_PLOTS, mode)
+}
+
+fn scan_classic(
+    rng: &mut Rng,
+    c: &faint_core::detect::mht::ClassicHoughConfig,
+    mode: Mode,
+) -> Vec<faint_core::model::plot::Plot> {
+    plots(rng, c.area, 64, mode)
+}
+
+fn cube(rng: &mut Rng, c: &PhdConfig, mode: Mode) -> Vec<f32> {
+    let g = c.geometry;
+    let n = g
+        .n_range
+        .checked_mul(g.n_doppler)
+        .and_then(|x| x.checked_mul(g.n_azimuth));
+    reals(rng, len_or_short(n), mode, 1.0, true)
+}
+
+fn map(rng: &mut Rng, c: &CbmemberConfig, mode: Mode) -> Vec<f32> {
+    let g = c.geometry;
+    reals(
+        rng,
+        len_or_short(g.n_range.checked_mul(g.n_velocity)),
+        mode,
+        1.0,
+        true,
+    )
+}
+
+fn image(rng: &mut Rng, _c: &DpConfig, mode: Mode) -> Vec<f32> {
+    reals(rng, SIDE * SIDE, mode, 1.5, false)
+}
+
+/// The PSO-PHD-TBD preset on a 30 x 30 x 20 cube over the same extent.
+pub fn small_phd(v: Variant) -> PhdConfig {
+    let mut c = SixTargets::new(9.0).config(v);
+    let g = &mut c.geometry;
+    let (r, d, a) = (
+        g.range_cell * g.n_range as f32,
+        g.doppler_cell * g.n_doppler as f32,
+        g.azimuth_cell_deg * g.n_azimuth as f32,
+    );
+    g.n_range = 30;
+    g.n_doppler = 30;
+    g.n_azimuth = 20;
+    g.range_cell = r / 30.0;
+    g.doppler_cell = d / 30.0;
+    g.azimuth_cell_deg = a / 20.0;
+    c
+}
+
+/// Builds two detectors on a thread with a large stack (the host filters are large
+/// values) and runs the campaign there.
+fn on_big_stack<F>(f: F) -> Result<Outcome>
+where
+    F: FnOnce() -> Result<Outcome> + Send + 'static,
+{
+    thread::Builder::new()
+        .stack_size(512 << 20)
+        .spawn(f)
+        .context("cannot start the campaign thread")?
+        .join()
+        .map_err(|_| anyhow!("the campaign thread panicked outside a step"))?
+}
+
+fn pair<D>(
+    make: impl Fn() -> std::result::Result<D, faint_core::Error>,
+) -> Result<(Box<D>, Box<D>)> {
+    let a = Box::new(make().map_err(|e| anyhow!("{e}"))?);
+    let b = Box::new(make().map_err(|e| anyhow!("{e}"))?);
+    Ok((a, b))
+}
+
+/// What to do with a detector.
+#[derive(Debug, Clone, Copy)]
+pub enum Job {
+    /// A fuzz campaign.
+    Fuzz(Options),
+    /// A soak run: frames, seed.
+    Soak(u64, u64),
+}
+
+/// What a [`Job`] measured.
+#[derive(Debug, Clone)]
+pub enum Outcome {
+    /// Of [`Job::Fuzz`].
+    Fuzz(Tally),
+    /// Of [`Job::Soak`].
+    Soak(Soak),
+}
+
+fn go<D, T>(
+    name: &'static str,
+    base: Value,
+    frame: fn(&mut Rng, &D::Config, Mode) -> Vec<T>,
+    (mut a, mut b): (Box<D>, Box<D>),
+    job: &Job,
+) -> Outcome
+where
+    D: Detector<Frame = [T]> + ?Sized,
+    D::Config: Serialize + serde::de::DeserializeOwned,
+    D::Report: std::fmt::Debug,
+{
+    let t = Target { name, base, frame };
+    match *job {
+        Job::Fuzz(opts) => Outcome::Fuzz(fuzz(&t, a.as_mut(), b.as_mut(), &opts)),
+        Job::Soak(frames, seed) => Outcome::Soak(soak(&t, a.as_mut(), frames, seed)),
+    }
+}
+
+fn boxed2<D: faint_core::detect::dp::DpTrack + sdp::ZeroValid>(
+    c: &DpConfig,
+) -> Result<(Box<D>, Box<D>)> {
+    Ok((sdp::boxed::<D>(c)?, sdp::boxed::<D>(c)?))
+}
+
+/// Runs `job` on the detector `name` (one of [`NAMES`]).
+pub fn run(name: &str, job: Job) -> Result<Outcome> {
+    let name: &'static str = NAMES
+        .iter()
+        .copied()
+        .find(|n| *n == name)
+        .ok_or_else(|| anyhow!("unknown detector '{name}'; known: {}", NAMES.join(", ")))?;
+    on_big_stack(move || {
+        let o = &job;
+        Ok(match name {
+            "crpf" => {
+                let c = CrpfConfig::othr();
+                go(
+                    name,
+                    to_value(&c),
+                    doppler_crpf,
+                    pair(|| CrpfTbd::<PARTICLES>::new(c, 0))?,
+                    o,
+                )
+            }
+            "pf-tbd" | "jott" | "pf-lrt" => {
+                let c = GaussConfig::othr(1.0);
+                match name {
+                    "pf-tbd" => go(
+                        name,
+                        to_value(&c),
+                        doppler_gauss,
+                        pair(|| PfTbd::<PARTICLES>::new(c, 0))?,
+                        o,
+                    ),
+                    "jott" => go(
+                        name,
+                        to_value(&c),
+                        doppler_gauss,
+                        pair(|| BernoulliTbd::<PARTICLES>::new(c, 0))?,
+                        o,
+                    ),
+                    _ => go(
+                        name,
+                        to_value(&c),
+                        doppler_gauss,
+                        pair(|| PfLrt::<PARTICLES>::new(c, 0))?,
+                        o,
+                    ),
+                }
+            }
+            "mht" => {
+                let c = MhtConfig::sea_clutter();
+                go(name, to_value(&c), scan_mht, pair(|| Mht::new(c))?, o)
+            }
+            "hough-classic" => {
+                let c = default_classic();
+                go(
+                    name,
+                    to_value(&c),
+                    scan_classic,
+                    pair(|| Classic::new(c))?,
+                    o,
+                )
+            }
+            "phd-tbd" | "pso-phd-kmeans" | "pso-phd-dbscan" => {
+                let v = match name {
+                    "phd-tbd" => Variant::PhdTbd,
+                    "pso-phd-kmeans" => Variant::PsoKMeans,
+                    _ => Variant::PsoDbscan,
+                };
+                let c = small_phd(v);
+                go(name, to_value(&c), cube, pair(|| PhdHost::new(c, 0))?, o)
+            }
+            "cbmember" | "cbmember-doppler" => {
+                let model = if name == "cbmember" {
+                    PointModel::Joint
+                } else {
+                    PointModel::DopplerOnly
+                };
+                let c = CbmemberConfig {
+                    model,
+                    ..CbmemberConfig::rotor_uav()
+                };
+                go(
+                    name,
+                    to_value(&c),
+                    map,
+                    pair(|| CbmemberHost::new(c, 0))?,
+                    o,
+                )
+            }
+            "dp-arnold" | "dp-pulford" | "dp-second" => {
+                let m = match name {
+                    "dp-arnold" => Method::Arnold,
+                    "dp-pulford" => Method::Pulford,
+                    _ => Method::SecondOrder,
+                };
+                let c = DpConfig::dim_point(m, 1);
+                match m {
+                    Method::Arnold => go(name, to_value(&c), image, boxed2::<sdp::Arnold9>(&c)?, o),
+                    Method::Pulford => {
+                        go(name, to_value(&c), image, boxed2::<sdp::Pulford9>(&c)?, o)
+                    }
+                    _ => go(name, to_value(&c), image, boxed2::<sdp::Second9>(&c)?, o),
+                }
+            }
+            other => bail!("unknown detector '{other}'"),
+        })
+    })
+}
