@@ -227,9 +227,9 @@ fn brute_clusters(pts: &[[f32; 2]], eps: f32, min_pts: usize) -> Vec<Vec<u32>> {
             if !core[a] {
                 continue;
             }
-            for b in 0..n {
-                if label[b] < 0 && near(a, b) {
-                    label[b] = id;
+            for (b, l) in label.iter_mut().enumerate() {
+                if *l < 0 && near(a, b) {
+                    *l = id;
                     members.push(b as u32);
                     q.push(b);
                 }

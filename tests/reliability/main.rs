@@ -14,5 +14,5 @@ fn checked_build() {
         faint::host::reliability::overflow_checks_on(),
         "the reliability tests must run with overflow checks on"
     );
-    assert!(cfg!(debug_assertions));
+    const { assert!(cfg!(debug_assertions)) };
 }

@@ -213,10 +213,10 @@ impl<const P: usize> Censor<P> {
                 pts[j] = geom.quantise(p.x, p.y);
             }
             if geom.share_cell(&pts[..m]) {
-                for j in 0..m {
+                for (j, &c) in chain.iter().enumerate().take(m) {
                     let Some(f) = flags
                         .get_mut(s0 + j)
-                        .and_then(|row| row.get_mut(usize::from(chain[j])))
+                        .and_then(|row| row.get_mut(usize::from(c)))
                     else {
                         continue;
                     };

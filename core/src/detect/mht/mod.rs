@@ -62,8 +62,8 @@ pub fn in_area(p: &Plot, area: [f32; 4]) -> bool {
 pub const MAX_COORDINATE: f32 = 1e18;
 
 pub(crate) fn validate_area(area: [f32; 4]) -> Result<()> {
-    if area.iter().any(|v| !(v.abs() <= MAX_COORDINATE)) || area[1] <= area[0] || area[3] <= area[2]
-    {
+    let inside = |v: &f32| v.abs() <= MAX_COORDINATE; // false for NaN
+    if !area.iter().all(inside) || area[1] <= area[0] || area[3] <= area[2] {
         return Err(Error::InvalidConfig("area"));
     }
     Ok(())

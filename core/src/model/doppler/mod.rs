@@ -187,7 +187,7 @@ impl ModelConfig {
                 "prior box Doppler rate (|fda| <= W / dT)",
             ));
         }
-        if !(self.prior.amp.1 <= max_amplitude(self.bins)) {
+        if self.prior.amp.1 > max_amplitude(self.bins) {
             return Err(Error::InvalidConfig(
                 "prior box amplitude (at most 1e18 / m)",
             ));
