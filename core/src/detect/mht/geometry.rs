@@ -187,16 +187,17 @@ impl<const R: usize, const A: usize> Geometry<R, A> {
 
     /// Rho cell of integer coordinates at angle `a` (integer quantiser), in `0..R`.
     /// Coordinates are those of [`quantise`](Self::quantise) (`|xq|, |yq| <= 32767`;
-    /// larger ones are clamped); the angle `theta_0 = 0` for `a >= A`.
+    /// larger ones give an unspecified cell in `0..R`); the angle `theta_0 = 0` for
+    /// `a >= A`.
     #[inline]
     pub fn rho_index_q(&self, xq: i32, yq: i32, a: usize) -> usize {
         let (c, s) = match (self.cos_q.get(a), self.sin_q.get(a)) {
             (Some(&c), Some(&s)) => (c, s),
             _ => (TRIG_Q as i32, 0),
         };
-        let (xq, yq) = (xq.clamp(-32767, 32767), yq.clamp(-32767, 32767));
-        // |acc| <= 2 * 32767 * 16384 < 2^31.
-        let acc = xq * c + yq * s;
+        // |acc| <= 2 * 32767 * 16384 < 2^31 for quantised coordinates; others wrap (no
+        // panic, a cell in 0..R all the same).
+        let acc = xq.wrapping_mul(c).wrapping_add(yq.wrapping_mul(s));
         let u = (i64::from(acc) + self.rmax_q).max(0) as u64;
         (((u * self.mul_q) >> 32) as usize).min(R - 1)
     }
