@@ -13,6 +13,12 @@
 //! the winner is the back-pointer: 4 bits as is for `q_B = 9`, re-coded to the
 //! `ceil(log2 q_B)`-bit window index for larger windows.
 //!
+//! For `q_B = 9`, even `M` and a frame that needs no clamping, one column pass computes
+//! two output rows: the row maxima of four rows are held interleaved per pixel (in the
+//! row-key buffer), two new rows per pass, and the middle pair of the two columns is
+//! shared. On the Cortex-M4 that pass is DSP assembly; the portable code gives the same
+//! merits and back-pointers.
+//!
 //! Memory ([`arnold_bytes`](super::arnold_bytes)): `M^2 sizeof(C)` merits, `9 M 4`
 //! bytes of row keys, `8 M` of row buffers, `4 W = (L - 1) ceil(M^2 b / 32) 4` bytes of
 //! back-pointers (`b = 4` for `q_B = 9`: 8 KiB per frame at `M = 128`) and the fixed

@@ -240,8 +240,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                     // merit and filter rows looked up once)
                     for dy in 0..n {
                         let yy = (y + dy).wrapping_sub(r);
-                        let (Some(mrow), Some(krow)) = (self.merit.get(yy), self.kf.get(yy))
-                        else {
+                        let (Some(mrow), Some(krow)) = (self.merit.get(yy), self.kf.get(yy)) else {
                             continue;
                         };
                         for dx in 0..n {
