@@ -2,7 +2,7 @@
 //! 2016): best merits, the merits of every pixel and the recovered best tracks of the
 //! three recursions on a 12 x 12 scene of 10 frames (noise `N(0, 1.5^2)`, one target at
 //! SNR 3 moving at (0.8, 0.5) px/frame), with `q_B = 9` and, for the first and second
-//! order, 25; and one frame of huge finite values. Stack use ~15 KiB (the detectors live
+//! order, 25 (`q_B = 9` also with `i8` merits for both orders); and one frame of huge finite values. Stack use ~15 KiB (the detectors live
 //! on the stack).
 //!
 //! [`frame`] is also the firmware's scene (at 128 x 128 and 64 x 64).
@@ -114,6 +114,12 @@ pub(crate) fn cases(emit: &mut dyn FnMut(&str, &[u32])) {
     emit_run(
         "dp.arnold9",
         &mut ArnoldDp::<M, 9, L, { arnold_words(M, 9, L) }>::unconfigured(),
+        &a,
+        emit,
+    );
+    emit_run(
+        "dp.arnold9_i8",
+        &mut ArnoldDp::<M, 9, L, { arnold_words(M, 9, L) }, i8>::unconfigured(),
         &a,
         emit,
     );

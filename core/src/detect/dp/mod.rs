@@ -227,9 +227,22 @@ pub trait MeritCell: Copy + PartialEq + core::fmt::Debug + sealed::Sealed {
 }
 
 mod sealed {
-    pub trait Sealed {}
-    impl Sealed for i16 {}
-    impl Sealed for i8 {}
+    pub trait Sealed {
+        /// `v` (already in the cell's range) as a cell.
+        fn trunc(v: i32) -> Self;
+    }
+    impl Sealed for i16 {
+        #[inline(always)]
+        fn trunc(v: i32) -> Self {
+            v as i16
+        }
+    }
+    impl Sealed for i8 {
+        #[inline(always)]
+        fn trunc(v: i32) -> Self {
+            v as i8
+        }
+    }
 }
 
 impl MeritCell for i16 {
@@ -475,13 +488,22 @@ impl Quant {
     /// Checks a frame: `Err(NonFinite)` on NaN/inf, else whether some pixel needs the
     /// clamping path (`|z| >= 2^e'`).
     pub(crate) fn check(&self, frame: &[f32]) -> Result<bool> {
+        // `bits << 1` (sign dropped) + `(256 - e) << 24` carries exactly for `|z| >= 2^e'`:
+        // one add and one add-with-carry per pixel
+        let add = self.large_add << 1;
         let mut large = 0u32;
-        for c in frame.chunks(4) {
+        let mut it = frame.chunks_exact(8);
+        for c in it.by_ref() {
             for z in c {
-                large |= (z.to_bits() & EXP_MASK).wrapping_add(self.large_add);
+                let (_, carry) = (z.to_bits() << 1).overflowing_add(add);
+                large += u32::from(carry);
             }
         }
-        if large & 0x8000_0000 == 0 {
+        for z in it.remainder() {
+            let (_, carry) = (z.to_bits() << 1).overflowing_add(add);
+            large += u32::from(carry);
+        }
+        if large == 0 {
             return Ok(false);
         }
         if frame.iter().any(|z| !z.is_finite()) {

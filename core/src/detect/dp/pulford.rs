@@ -236,23 +236,25 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 let ds = y & (DELAY - 1);
                 for x in 0..M {
                     let mut v = FLOOR_KEY;
-                    for (j, (dy, dx)) in (0..n)
-                        .flat_map(|jy| (0..n).map(move |jx| (jy, jx)))
-                        .enumerate()
-                    {
+                    // candidates in window order j = dy n + dx (rows of the window: their
+                    // merit and filter rows looked up once)
+                    for dy in 0..n {
                         let yy = (y + dy).wrapping_sub(r);
-                        let xx = (x + dx).wrapping_sub(r);
-                        let (Some(c), Some(f)) = (
-                            self.merit.get(yy).and_then(|row| row.get(xx)),
-                            self.kf.get(yy).and_then(|row| row.get(xx)),
-                        ) else {
+                        let (Some(mrow), Some(krow)) = (self.merit.get(yy), self.kf.get(yy)) else {
                             continue;
                         };
-                        let ok = f.age == 0
-                            || ((x as i32 - i32::from(f.px)).abs() <= g
-                                && (y as i32 - i32::from(f.py)).abs() <= g);
-                        if ok {
-                            v = v.max((c.get() << Self::SH) | j as i32);
+                        for dx in 0..n {
+                            let xx = (x + dx).wrapping_sub(r);
+                            let (Some(c), Some(f)) = (mrow.get(xx), krow.get(xx)) else {
+                                continue;
+                            };
+                            let ok = f.age == 0
+                                || ((x as i32 - i32::from(f.px)).abs() <= g
+                                    && (y as i32 - i32::from(f.py)).abs() <= g);
+                            if ok {
+                                let j = (dy * n + dx) as i32;
+                                v = v.max((c.get() << Self::SH) | j);
+                            }
                         }
                     }
                     let zq = self.zrow[x];

@@ -69,6 +69,9 @@ pub(crate) struct Layout {
     pub(crate) suffix: [u32; MAXQ],
     /// Bits of one pixel's code.
     pub(crate) bits: u32,
+    /// State `d`'s share of its chunk's code, `j suffix[d]`, by the separable key code
+    /// `(ey + 1) << 2 | (ex + 1)` of its winner (0 for codes that cannot win).
+    pub(crate) jterm: [[u32; 16]; MAXQ],
 }
 
 const fn bits_u64(n: u64) -> u32 {
@@ -91,6 +94,7 @@ pub(crate) const fn layout(qb: usize) -> Layout {
         chunk_last: [false; MAXQ],
         suffix: [1; MAXQ],
         bits: 0,
+        jterm: [[0; 16]; MAXQ],
     };
     let r = radius_of(qb);
     if r == 0 || r > 2 {
@@ -147,6 +151,26 @@ pub(crate) const fn layout(qb: usize) -> Layout {
         off += bits;
     }
     l.bits = off;
+    // jterm: candidate j = (cy - cy_min) n_x + (cx - cx_min) of code cy << 2 | cx
+    let mut d = 0;
+    while d < qb {
+        let (dxi, dyi) = (d % n, d / n);
+        let cxmin = (dxi + 1).saturating_sub(2 * r);
+        let cymin = (dyi + 1).saturating_sub(2 * r);
+        let cxmax = if dxi + 1 < 2 { dxi + 1 } else { 2 };
+        let cymax = if dyi + 1 < 2 { dyi + 1 } else { 2 };
+        let nx = cxmax + 1 - cxmin;
+        let mut c = 0;
+        while c < 16 {
+            let (cx, cy) = (c & 3, c >> 2);
+            if cx >= cxmin && cx <= cxmax && cy >= cymin && cy <= cymax {
+                let j = (cy - cymin) * nx + (cx - cxmin);
+                l.jterm[d][c] = j as u32 * l.suffix[d];
+            }
+            c += 1;
+        }
+        d += 1;
+    }
     l
 }
 
@@ -343,7 +367,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         bw: &mut Option<BitWriter<'_>>,
     ) {
         let lay = &Self::LAY;
-        let (n, r) = (Self::N, Self::R);
+        let n = Self::N;
         let gk = *gk;
         for (cell, out) in src.iter().zip(dst.iter_mut()) {
             // hx[p_y][dx] over ex with p_x = dx - ex inside the window
@@ -381,19 +405,10 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                     }
                 }
                 *o = C::sat(v >> 4);
-                // candidate index j = (cy - cy_min) n_x + (cx - cx_min)
-                let (cxmin, cymin) = (
-                    (dxi + 1).saturating_sub(2 * r),
-                    (dyi + 1).saturating_sub(2 * r),
-                );
-                let nx = (dxi + 1).min(2) + 1 - cxmin;
-                let cx = (v & 3) as usize;
-                let cy = ((v >> 2) & 3) as usize;
-                let j = (cy.wrapping_sub(cymin))
-                    .wrapping_mul(nx)
-                    .wrapping_add(cx.wrapping_sub(cxmin));
-                let nd = u32::from(lay.nopt.get(d).copied().unwrap_or(1));
-                acc = acc.wrapping_mul(nd).wrapping_add(j as u32);
+                // the chunk's code, sum of j suffix[d] (the candidate index j of the
+                // winner's code, from a table)
+                let term = lay.jterm.get(d).map_or(0, |t| t[(v & 15) as usize]);
+                acc = acc.wrapping_add(term);
                 if lay.chunk_last.get(d).copied().unwrap_or(false) {
                     if let Some(w) = bw.as_mut() {
                         w.push(acc, u32::from(lay.chunk_bits.get(d).copied().unwrap_or(1)));
@@ -505,6 +520,8 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                             edge(x, cell, zq, &mut rb, &mut rx);
                             continue;
                         }
+                        // (the pixel's best first: the same first-in-row-major winner)
+                        let mut pb = i32::MIN;
                         for (s, c) in cell.iter_mut().enumerate() {
                             let (dx, dy) = (s % n, s / n);
                             let j = jr[dy % 5]
@@ -512,10 +529,12 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                                 .and_then(|jc| jc.get(s))
                                 .map_or(C::FLOOR, |v| v.get());
                             *c = C::sat(zq + j);
-                            if c.get() > rb {
-                                rb = c.get();
-                                rx = x;
-                            }
+                            let v = c.get();
+                            pb = if v > pb { v } else { pb };
+                        }
+                        if pb > rb {
+                            rb = pb;
+                            rx = x;
                         }
                     }
                 }
