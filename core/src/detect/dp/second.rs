@@ -72,6 +72,9 @@ pub(crate) struct Layout {
     /// State `d`'s share of its chunk's code, `j suffix[d]`, by the separable key code
     /// `(ey + 1) << 2 | (ex + 1)` of its winner (0 for codes that cannot win).
     pub(crate) jterm: [[u32; 16]; MAXQ],
+    /// States `2i - 1` and `2i` together (same chunk): `jterm` of both, by the codes
+    /// `c_{2i-1} | c_{2i} << 4`.
+    pub(crate) jpair: [[u32; 256]; MAXQ / 2],
 }
 
 const fn bits_u64(n: u64) -> u32 {
@@ -95,6 +98,7 @@ pub(crate) const fn layout(qb: usize) -> Layout {
         suffix: [1; MAXQ],
         bits: 0,
         jterm: [[0; 16]; MAXQ],
+        jpair: [[0; 256]; MAXQ / 2],
     };
     let r = radius_of(qb);
     if r == 0 || r > 2 {
@@ -170,6 +174,16 @@ pub(crate) const fn layout(qb: usize) -> Layout {
             c += 1;
         }
         d += 1;
+    }
+    let mut i = 1;
+    while 2 * i < qb {
+        let (a, b) = (2 * i - 1, 2 * i);
+        let mut c = 0;
+        while c < 256 {
+            l.jpair[i - 1][c] = l.jterm[a][c & 15] + l.jterm[b][c >> 4];
+            c += 1;
+        }
+        i += 1;
     }
     l
 }
@@ -325,7 +339,14 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             return;
         }
         if let Some(gk) = sep {
-            Self::j_row_sep(src, dst, gk, bw);
+            // (the writer in locals for the row, not behind the reference)
+            match bw.take() {
+                Some(mut w) => {
+                    Self::j_row_sep(src, dst, gk, |c, b| w.push(c, b));
+                    *bw = Some(w);
+                }
+                None => Self::j_row_sep(src, dst, gk, |_, _| {}),
+            }
             return;
         }
         for (cell, out) in src.iter().zip(dst.iter_mut()) {
@@ -364,7 +385,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         src: &[[C; QB]; M],
         dst: &mut [[C; QB]; M],
         gk: &[i32; 6],
-        bw: &mut Option<BitWriter<'_>>,
+        mut push: impl FnMut(u32, u32),
     ) {
         let lay = &Self::LAY;
         let n = Self::N;
@@ -388,7 +409,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                     *h = v;
                 }
             }
-            let mut acc = 0u32;
+            let (mut acc, mut prev) = (0u32, 0i32);
             for (d, o) in out.iter_mut().enumerate() {
                 let (dyi, dxi) = (d / n, d % n);
                 let (mut v, mut first) = (FLOOR_KEY, true);
@@ -406,13 +427,20 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 }
                 *o = C::sat(v >> 4);
                 // the chunk's code, sum of j suffix[d] (the candidate index j of the
-                // winner's code, from a table)
-                let term = lay.jterm.get(d).map_or(0, |t| t[(v & 15) as usize]);
-                acc = acc.wrapping_add(term);
-                if lay.chunk_last.get(d).copied().unwrap_or(false) {
-                    if let Some(w) = bw.as_mut() {
-                        w.push(acc, u32::from(lay.chunk_bits.get(d).copied().unwrap_or(1)));
-                    }
+                // winner's code, from a table; states 2i - 1, 2i of one chunk as a pair)
+                let last = lay.chunk_last.get(d).copied().unwrap_or(false);
+                let paired = d % 2 == 1 && d + 1 < QB && !last;
+                if d % 2 == 0 && d > 0 && !lay.chunk_last.get(d - 1).copied().unwrap_or(true) {
+                    let c = ((prev & 15) | ((v & 15) << 4)) as usize;
+                    let term = lay.jpair.get(d / 2 - 1).map_or(0, |t| t[c]);
+                    acc = acc.wrapping_add(term);
+                } else if !paired {
+                    let term = lay.jterm.get(d).map_or(0, |t| t[(v & 15) as usize]);
+                    acc = acc.wrapping_add(term);
+                }
+                prev = v;
+                if last {
+                    push(acc, u32::from(lay.chunk_bits.get(d).copied().unwrap_or(1)));
                     acc = 0;
                 }
             }
