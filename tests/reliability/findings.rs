@@ -331,3 +331,37 @@ fn public_hough_helpers_are_total() {
     }
     assert!(flags.iter().flatten().any(|f| *f != 0));
 }
+
+#[test]
+fn censoring_with_a_gate_wider_than_the_area_is_bounded() {
+    // A gate of 1e10 m with m = 6 made every pair of plots a candidate and the chain
+    // search visit up to P^5 partial chains (2.9 s for one scan; fuzz corpus
+    // `mht-slow-935-0.json`); the budget of completed chains did not bound the partial
+    // ones. The search now stops after NODE_BUDGET_PER_PLOT * P partial chains.
+    use faint::core::detect::mht::censoring::NODE_BUDGET_PER_PLOT;
+    let g = Geometry::<256, 180>::for_area([0.0, 6000.0, 0.0, 6000.0]);
+    let mut rng = Rng::seed_from_u64(8);
+    // 64 plots per scan in a capacity of 256: 256 gated pairs per scan, about four
+    // continuations per partial chain. The sixth scan is empty, so no chain completes
+    // (the chain budget never binds) while the window holds 256 + 1024 + 4096 + 16384
+    // partial chains, more than the node budget of 64 * 256.
+    const P: usize = 256;
+    let scans: Vec<Vec<Plot>> = (0..6)
+        .map(|k| {
+            let n = if k == 5 { 0 } else { 64 };
+            (0..n)
+                .map(|_| Plot::new(1.0, 6000.0 * rng.uniform(), 6000.0 * rng.uniform()))
+                .collect()
+        })
+        .collect();
+    let refs: Vec<&[Plot]> = scans.iter().map(|s| s.as_slice()).collect();
+    let mut flags = vec![[0u8; P]; 6];
+    let mut c = Box::new(Censor::<P>::new());
+    let mut last = Default::default();
+    for s in 0..6 {
+        last = c.step(&g, &refs, &mut flags, s, 6, 1e10);
+    }
+    assert_eq!(last.chains, 0);
+    assert!(last.chain_overflow > 0, "the node budget never engaged");
+    assert!(NODE_BUDGET_PER_PLOT * (P as u32) < 256 + 1024 + 4096 + 16384);
+}

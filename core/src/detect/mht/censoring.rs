@@ -38,11 +38,17 @@ pub struct CensorStats {
     pub pair_overflow: u32,
     /// Complete chains tested for a common cell.
     pub chains: u32,
-    /// Chains not tested because the per-scan chain budget was spent.
+    /// Chains not tested because the per-scan chain budget (or the budget of partial
+    /// chains visited, [`NODE_BUDGET_PER_PLOT`] per plot) was spent.
     pub chain_overflow: u32,
     /// Plots newly marked effective by this step's window.
     pub newly_effective: u32,
 }
+
+/// Partial chains a step may visit per plot of capacity: bounds the search when the
+/// gate admits almost every pair (a gate larger than the area makes the chains of a
+/// window up to `P^(m-1)`; with the preset's gate a scan visits far fewer).
+pub const NODE_BUDGET_PER_PLOT: u32 = 64;
 
 /// Working memory of the censoring stage for scans of at most `P` plots.
 #[derive(Debug, Clone)]
@@ -151,7 +157,11 @@ impl<const P: usize> Censor<P> {
         let mut pts = [(0i32, 0i32); MAX_M];
         let first = (s0 + 1) % MAX_M;
         let nfirst = usize::from(self.npairs[first]);
-        let mut budget = self.chain_budget;
+        // (completed chains, partial chains visited) still allowed in this step.
+        let mut budget = (
+            self.chain_budget,
+            NODE_BUDGET_PER_PLOT.saturating_mul(P as u32),
+        );
         for i in 0..nfirst {
             let (a, b) = self.pairs[first][i];
             chain[0] = a;
@@ -183,15 +193,20 @@ impl<const P: usize> Censor<P> {
         len: usize,
         chain: &mut [u16; MAX_M],
         pts: &mut [(i32, i32); MAX_M],
-        budget: &mut u32,
+        budget: &mut (u32, u32),
         st: &mut CensorStats,
     ) {
+        if budget.1 == 0 {
+            st.chain_overflow += 1;
+            return;
+        }
+        budget.1 -= 1;
         if len == m {
-            if *budget == 0 {
+            if budget.0 == 0 {
                 st.chain_overflow += 1;
                 return;
             }
-            *budget -= 1;
+            budget.0 -= 1;
             let flag = |flags: &[[u8; P]], j: usize| {
                 flags
                     .get(s0 + j)
