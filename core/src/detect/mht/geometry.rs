@@ -195,6 +195,12 @@ impl<const R: usize, const A: usize> Geometry<R, A> {
             (Some(&c), Some(&s)) => (c, s),
             _ => (TRIG_Q as i32, 0),
         };
+        self.rho_cell_q(xq, yq, c, s)
+    }
+
+    /// [`rho_index_q`](Self::rho_index_q) with the angle's Q14 `(cos, sin)` given.
+    #[inline(always)]
+    fn rho_cell_q(&self, xq: i32, yq: i32, c: i32, s: i32) -> usize {
         // |acc| <= 2 * 32767 * 16384 < 2^31 for quantised coordinates; others wrap (no
         // panic, a cell in 0..R all the same).
         let acc = xq.wrapping_mul(c).wrapping_add(yq.wrapping_mul(s));
@@ -205,8 +211,8 @@ impl<const R: usize, const A: usize> Geometry<R, A> {
     /// Rho cells of one point for every angle, integer quantiser, into `out` (length `A`).
     #[inline]
     pub fn curve_q(&self, xq: i32, yq: i32, out: &mut [u16; A]) {
-        for (a, o) in out.iter_mut().enumerate() {
-            *o = self.rho_index_q(xq, yq, a) as u16;
+        for (o, (&c, &s)) in out.iter_mut().zip(self.cos_q.iter().zip(&self.sin_q)) {
+            *o = self.rho_cell_q(xq, yq, c, s) as u16;
         }
     }
 
@@ -216,10 +222,10 @@ impl<const R: usize, const A: usize> Geometry<R, A> {
         let Some((&first, rest)) = pts.split_first() else {
             return false;
         };
-        'angles: for a in 0..A {
-            let r0 = self.rho_index_q(first.0, first.1, a);
+        'angles: for (&c, &s) in self.cos_q.iter().zip(&self.sin_q) {
+            let r0 = self.rho_cell_q(first.0, first.1, c, s);
             for p in rest {
-                if self.rho_index_q(p.0, p.1, a) != r0 {
+                if self.rho_cell_q(p.0, p.1, c, s) != r0 {
                     continue 'angles;
                 }
             }
