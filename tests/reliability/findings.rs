@@ -305,7 +305,7 @@ fn areas_near_f32_max_are_rejected() {
 }
 
 #[test]
-fn public_hough_helpers_are_total() {
+fn public_hough_functions_are_total() {
     // Geometry::rho, rho_index_q and trig indexed past the angle count; Censor::step
     // trusted its m and flags.
     let g = Geometry::<64, 16>::for_area([0.0, 100.0, 0.0, 100.0]);
