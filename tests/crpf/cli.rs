@@ -1,18 +1,7 @@
 //! `faint reproduce crpf` checks its arguments before any Monte Carlo work: one line
 //! naming the argument and the value; `--quick` never overrides a value given.
 
-use std::process::Command;
-
-fn faint(args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_faint"))
-        .args(args)
-        .output()
-        .expect("run faint");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use crate::common::faint;
 
 fn temp(name: &str) -> std::path::PathBuf {
     std::env::temp_dir().join(format!("faint_crpf_cli_{name}_{}", std::process::id()))
@@ -26,10 +15,7 @@ fn all_fail(cases: &[(&[&str], &str)]) {
         let mut all = vec!["--quiet", "reproduce", "crpf", "--out", out];
         all.extend_from_slice(args);
         let (code, err) = faint(&all);
-        assert_ne!(code, 0, "{args:?}");
-        assert!(err.contains(needle), "{args:?}: {err}");
-        assert!(!err.contains("panicked"), "{err}");
-        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        crate::common::assert_one_line_error(code, &err, needle, args);
         // Nothing was written: the check comes before the output directory and the runs.
         assert!(!dir.exists(), "{args:?} created {}", dir.display());
     }

@@ -4,6 +4,8 @@
 
 mod calibration;
 mod cli;
+#[path = "../common/cli.rs"]
+mod common;
 mod detectors;
 mod model;
 mod noise;

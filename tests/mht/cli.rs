@@ -35,15 +35,9 @@ fn reproduce_mht_quick_finishes_and_writes_summary() {
 
 /// Runs `faint --quiet reproduce mht <args>`: `(exit code, stderr)`.
 fn mht(args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_faint"))
-        .args(["--quiet", "reproduce", "mht"])
-        .args(args)
-        .output()
-        .expect("run faint");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let mut all = vec!["--quiet", "reproduce", "mht"];
+    all.extend_from_slice(args);
+    crate::common::faint(&all)
 }
 
 #[test]
@@ -99,10 +93,7 @@ fn bad_arguments_are_one_line_naming_the_argument_quick_or_not() {
         let mut all = vec!["--out", out];
         all.extend_from_slice(args);
         let (code, err) = mht(&all);
-        assert_ne!(code, 0, "{args:?}");
-        assert!(err.contains(needle), "{args:?}: {err}");
-        assert!(!err.contains("panicked"), "{err}");
-        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        crate::common::assert_one_line_error(code, &err, needle, args);
         assert!(!dir.exists(), "{args:?} created {}", dir.display());
     }
 }

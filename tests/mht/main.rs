@@ -5,6 +5,8 @@
 
 mod calibration;
 mod cli;
+#[path = "../common/cli.rs"]
+mod common;
 mod detector;
 mod model;
 mod paper_gamma;

@@ -52,15 +52,9 @@ fn reproduce_psophd_rejects_bad_arguments_before_any_run() {
 
 /// Runs `faint --quiet reproduce phd <args>`: `(exit code, stderr)`.
 fn phd(args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_faint"))
-        .args(["--quiet", "reproduce", "phd"])
-        .args(args)
-        .output()
-        .expect("run faint");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let mut all = vec!["--quiet", "reproduce", "phd"];
+    all.extend_from_slice(args);
+    crate::common::faint(&all)
 }
 
 #[test]
@@ -101,10 +95,7 @@ fn counts_and_snrs_are_checked_quick_or_not() {
         let mut all = vec!["--out", out];
         all.extend_from_slice(args);
         let (code, err) = phd(&all);
-        assert_ne!(code, 0, "{args:?}");
-        assert!(err.contains(needle), "{args:?}: {err}");
-        assert!(!err.contains("panicked"), "{err}");
-        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        crate::common::assert_one_line_error(code, &err, needle, args);
         assert!(!dir.exists(), "{args:?} created {}", dir.display());
     }
 }

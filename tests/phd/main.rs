@@ -4,4 +4,6 @@
 
 mod algorithms;
 mod cli;
+#[path = "../common/cli.rs"]
+mod common;
 mod filter;

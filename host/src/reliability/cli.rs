@@ -1,12 +1,12 @@
 //! `faint fuzz` and `faint soak`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use rayon::prelude::*;
 
 use super::soak::Soak;
-use super::targets::{run, Job, Outcome, NAMES};
+use super::targets::{run, Job, Outcome};
 use super::{overflow_checks_on, Options, Tally};
 use crate::montecarlo::progress_bar;
 
@@ -55,19 +55,11 @@ pub struct SoakArgs {
 
 fn names(list: &[String]) -> Result<Vec<&'static str>> {
     if list.iter().any(|d| d == "all") {
-        return Ok(NAMES.to_vec());
+        return Ok(super::targets::names().collect());
     }
     list.iter()
-        .map(|d| {
-            NAMES.iter().copied().find(|n| n == d).with_context(|| {
-                format!("unknown detector '{d}'; known: all, {}", NAMES.join(", "))
-            })
-        })
+        .map(|d| Ok(crate::detect::find(d)?.name))
         .collect()
-}
-
-fn write(path: &Path, text: &str) -> Result<()> {
-    std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Adds `b` into `a`.
@@ -181,15 +173,15 @@ pub fn fuzz_command(args: &FuzzArgs) -> Result<()> {
                 serde_json::to_value(f.kind)?.as_str().unwrap_or("finding"),
                 f.case
             ));
-            write(&path, &serde_json::to_string_pretty(f)?)?;
+            crate::io::write_text(&path, &serde_json::to_string_pretty(f)?)?;
         }
     }
-    write(
-        &args.out.join("tally.json"),
+    crate::io::write_text(
+        args.out.join("tally.json"),
         &serde_json::to_string_pretty(&tallies)?,
     )?;
     let table = fuzz_table(&tallies);
-    write(&args.out.join("tally.md"), &table)?;
+    crate::io::write_text(args.out.join("tally.md"), &table)?;
     print!("{table}");
     let failures: u64 = tallies.iter().map(Tally::failures).sum();
     if failures > 0 {
@@ -240,12 +232,12 @@ pub fn soak_command(args: &SoakArgs) -> Result<()> {
             Outcome::Fuzz(_) => bail!("internal: a fuzz outcome from a soak job"),
         }
     }
-    write(
-        &args.out.join("soak.json"),
+    crate::io::write_text(
+        args.out.join("soak.json"),
         &serde_json::to_string_pretty(&all)?,
     )?;
     let table = soak_table(&all);
-    write(&args.out.join("soak.md"), &table)?;
+    crate::io::write_text(args.out.join("soak.md"), &table)?;
     print!("{table}");
     Ok(())
 }

@@ -34,23 +34,11 @@ use crate::scenario::phd::{HostFilter as PhdHost, SixTargets, Variant};
 /// Particles of the particle-filter detectors in a campaign (the smallest host size).
 pub const PARTICLES: usize = 1000;
 
-/// Names of every detector a campaign can drive (those of `faint detect --list`).
-pub const NAMES: [&str; 14] = [
-    "crpf",
-    "pf-tbd",
-    "jott",
-    "pf-lrt",
-    "mht",
-    "hough-classic",
-    "phd-tbd",
-    "pso-phd-kmeans",
-    "pso-phd-dbscan",
-    "cbmember",
-    "cbmember-doppler",
-    "dp-arnold",
-    "dp-pulford",
-    "dp-second",
-];
+/// Names of every detector a campaign can drive: those of `faint detect --list`
+/// ([`crate::detect::REGISTRY`]), in its order.
+pub fn names() -> impl Iterator<Item = &'static str> {
+    crate::detect::REGISTRY.iter().map(|e| e.name)
+}
 
 /// Largest frame a generator draws; a configuration asking for more gets wrong-length
 /// frames (what the detector must reject).
@@ -194,13 +182,9 @@ fn boxed2<D: faint_core::detect::dp::DpTrack + sdp::ZeroValid>(
     Ok((sdp::boxed::<D>(c)?, sdp::boxed::<D>(c)?))
 }
 
-/// Runs `job` on the detector `name` (one of [`NAMES`]).
+/// Runs `job` on the detector `name` (one of [`names`]).
 pub fn run(name: &str, job: Job) -> Result<Outcome> {
-    let name: &'static str = NAMES
-        .iter()
-        .copied()
-        .find(|n| *n == name)
-        .ok_or_else(|| anyhow!("unknown detector '{name}'; known: {}", NAMES.join(", ")))?;
+    let name: &'static str = crate::detect::find(name)?.name;
     on_big_stack(move || {
         let o = &job;
         Ok(match name {
