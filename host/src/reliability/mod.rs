@@ -337,7 +337,7 @@ fn run_case<D, T>(
         let t = Instant::now();
         let res = catch(|| {
             a.step(&frame)
-                .map(|r| (check_outputs(a, &r), outputs(a, &r)))
+                .map(|r| (check_outputs(a, &r), lockstep.then(|| outputs(a, &r))))
         });
         let dt = t.elapsed().as_secs_f64();
         tally.slowest_step_s = tally.slowest_step_s.max(dt);
@@ -363,7 +363,7 @@ fn run_case<D, T>(
                     tally.record(finding(kind, Some(k), Some(mode), msg));
                     return;
                 }
-                if lockstep {
+                if let Some(out_a) = out_a {
                     tally.lockstep_frames += 1;
                     match catch(|| b.step(&frame).map(|r| outputs(b, &r))) {
                         Ok(Ok(out_b)) if out_b == out_a => {}
