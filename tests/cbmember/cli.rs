@@ -2,26 +2,22 @@
 //! arguments are one-line errors naming the argument; `--quick` never overrides a value
 //! given on the command line.
 
-use std::process::Command;
+use crate::common::{assert_one_line_error, faint, s, temp};
 
 #[test]
 fn reproduce_cbmember_quick_writes_tables_and_plots() {
-    let dir = std::env::temp_dir().join(format!("faint-cbmember-{}", std::process::id()));
-    let out = Command::new(env!("CARGO_BIN_EXE_faint"))
-        .args([
-            "--quiet",
-            "reproduce",
-            "cbmember",
-            "--quick",
-            "--runs",
-            "1",
-            "--out",
-        ])
-        .arg(&dir)
-        .output()
-        .expect("run faint");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    let dir = temp("cbmember", "quick");
+    let args = [
+        "--quiet",
+        "reproduce",
+        "cbmember",
+        "--quick",
+        "--runs",
+        "1",
+        "--out",
+    ];
+    let (code, stderr) = faint(&[&args[..], &[s(&dir)]].concat());
+    assert_eq!(code, 0, "{stderr}");
     let md = std::fs::read_to_string(dir.join("summary.md")).unwrap();
     for needle in [
         "joint 1500",
@@ -68,15 +64,10 @@ fn reproduce_cbmember_rejects_bad_arguments_before_any_run() {
         (vec!["--sets", "fig12"], "--sets"),
         (vec!["--quick", "--runs", "0"], "--runs"),
     ] {
-        let out = Command::new(env!("CARGO_BIN_EXE_faint"))
-            .args(["--quiet", "reproduce", "cbmember"])
-            .args(&args)
-            .output()
-            .expect("run faint");
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "{args:?} accepted");
-        assert!(stderr.contains(needle), "{args:?}: {stderr}");
-        assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: {stderr}");
+        let mut all = vec!["--quiet", "reproduce", "cbmember"];
+        all.extend_from_slice(&args);
+        let (code, err) = faint(&all);
+        assert_one_line_error(code, &err, needle, &args);
     }
 }
 
@@ -120,15 +111,9 @@ fn reproduce_cbmember_names_the_bad_value_and_path() {
             "--out /proc/faint-no-such-dir",
         ),
     ] {
-        let out = Command::new(env!("CARGO_BIN_EXE_faint"))
-            .args(["--quiet", "reproduce", "cbmember"])
-            .args(&args)
-            .output()
-            .expect("run faint");
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "{args:?} accepted");
-        assert!(stderr.contains(needle), "{args:?}: {stderr}");
-        assert!(!stderr.contains("panicked"), "{stderr}");
-        assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: {stderr}");
+        let mut all = vec!["--quiet", "reproduce", "cbmember"];
+        all.extend_from_slice(&args);
+        let (code, err) = faint(&all);
+        assert_one_line_error(code, &err, needle, &args);
     }
 }

@@ -3,4 +3,6 @@
 //! family.
 
 mod cli;
+#[path = "../common/cli.rs"]
+mod common;
 mod filter;

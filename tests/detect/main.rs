@@ -8,39 +8,19 @@ mod commands;
 mod interface;
 mod round_trip;
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+#[path = "../common/cli.rs"]
+mod common;
 
-/// Runs the `faint` binary: `(exit code, stdout, stderr)`.
-pub fn faint(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_faint"))
-        .arg("--quiet")
-        .args(args)
-        .output()
-        .expect("run faint");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+pub use common::{faint_quiet as faint, s};
 
 /// A fresh temporary folder for one test.
-pub fn temp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("faint-detect-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+pub fn temp(name: &str) -> std::path::PathBuf {
+    common::temp("detect", name)
 }
 
 /// A NumPy-written fixture of `tests/data`.
-pub fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
+pub fn data(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data")
         .join(name)
-}
-
-/// `p` as a `&str`.
-pub fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }

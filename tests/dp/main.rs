@@ -9,32 +9,12 @@ mod cli;
 mod detector;
 mod host;
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+#[path = "../common/cli.rs"]
+mod common;
 
-/// Runs the `faint` binary: `(exit code, stdout, stderr)`.
-pub fn faint(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_faint"))
-        .arg("--quiet")
-        .args(args)
-        .output()
-        .expect("run faint");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+pub use common::{faint_quiet as faint, s};
 
 /// A fresh temporary folder for one test.
-pub fn temp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("faint-dp-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// `p` as a `&str`.
-pub fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
+pub fn temp(name: &str) -> std::path::PathBuf {
+    common::temp("dp", name)
 }
