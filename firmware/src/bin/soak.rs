@@ -105,8 +105,11 @@ impl Args {
         let line = unsafe {
             let buf = &mut *core::ptr::addr_of_mut!(CMDLINE);
             let mut block = [buf.as_mut_ptr() as usize, buf.len()];
-            if cortex_m_semihosting::syscall(cortex_m_semihosting::nr::GET_CMDLINE, &mut block) != 0
-            {
+            let rc = cortex_m_semihosting::syscall1(
+                cortex_m_semihosting::nr::GET_CMDLINE,
+                block.as_mut_ptr() as usize,
+            );
+            if rc != 0 {
                 return args;
             }
             let n = block[1].min(buf.len());
