@@ -51,7 +51,7 @@ pub const STACK_WINDOW: usize = 64 * 1024;
 const PAINT: u32 = 0x5AA5_C33C;
 /// Unpainted bytes right below the caller's SP (room for `paint`'s own frame): stack use
 /// that stays within this margin reads as the margin.
-const PAINT_MARGIN: usize = 64;
+pub const PAINT_MARGIN: usize = 64;
 
 static BASELINE: AtomicU32 = AtomicU32::new(0);
 
@@ -112,8 +112,9 @@ pub const fn ticks_to_instructions(ticks: u32) -> u32 {
     ((ticks as u64 * 40 + 512) >> 10) as u32
 }
 
+/// Runs `f` and returns its result and executed instructions, baseline not subtracted.
 #[inline(always)]
-fn raw_instructions<R>(f: impl FnOnce() -> R) -> (R, u32) {
+pub fn raw_instructions<R>(f: impl FnOnce() -> R) -> (R, u32) {
     compiler_fence(Ordering::SeqCst);
     let t0 = timer();
     compiler_fence(Ordering::SeqCst);
@@ -150,8 +151,9 @@ pub fn measure<R>(f: impl FnOnce() -> R) -> (R, Measurement) {
     (r, m)
 }
 
+/// Paints `[lo, hi)` (unused stack below the live frames) with the marker word.
 #[inline(never)]
-fn paint(lo: usize, hi: usize) {
+pub fn paint(lo: usize, hi: usize) {
     let mut a = lo;
     while a < hi {
         // SAFETY: [lo, hi) is unused stack below the live frames (hi is PAINT_MARGIN bytes
@@ -161,8 +163,9 @@ fn paint(lo: usize, hi: usize) {
     }
 }
 
+/// The lowest address in `[lo, hi)` whose marker word was overwritten (`hi`: none).
 #[inline(never)]
-fn lowest_touched(lo: usize, hi: usize) -> usize {
+pub fn lowest_touched(lo: usize, hi: usize) -> usize {
     let mut a = lo;
     // SAFETY: reads of the window painted above.
     while a < hi && unsafe { read_volatile(a as *const u32) } == PAINT {

@@ -17,6 +17,11 @@ pub fn set_quiet(quiet: bool) {
     QUIET.store(quiet, Ordering::Relaxed);
 }
 
+/// True after [`set_quiet`]`(true)`.
+pub fn quiet() -> bool {
+    QUIET.load(Ordering::Relaxed)
+}
+
 /// A progress bar of `n` steps labelled `label`, drawn on stderr when it is a terminal and
 /// hidden after [`set_quiet`]`(true)`.
 pub fn progress_bar(label: &str, n: usize) -> ProgressBar {

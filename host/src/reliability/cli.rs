@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use rayon::prelude::*;
 
-use super::soak::Soak;
+use super::soak::{Shape, Soak};
 use super::targets::{run, Job, Outcome};
 use super::{overflow_checks_on, Options, Tally};
 use crate::montecarlo::progress_bar;
@@ -48,6 +48,11 @@ pub struct SoakArgs {
     /// Seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Configuration size: `preset`, or `reduced` (smaller cubes, maps, images and
+    /// particle counts for PHD-TBD, PSO-PHD-TBD, CBMeMBer and DP-TBD, see
+    /// `reliability::soak::Shape`; the other detectors unchanged).
+    #[arg(long, value_enum, default_value_t = Shape::Preset)]
+    pub shape: Shape,
     /// Output folder: `soak.json` and `soak.md`.
     #[arg(long, default_value = "out/soak")]
     pub out: PathBuf,
@@ -196,12 +201,13 @@ pub fn fuzz_command(args: &FuzzArgs) -> Result<()> {
 /// Markdown table of soak runs.
 pub fn soak_table(s: &[Soak]) -> String {
     let mut t = String::from(
-        "| detector | frames | errors | NaN/inf outputs | us/frame first block | last block | worst block | RSS before (KiB) | after |\n|---|---|---|---|---|---|---|---|---|\n",
+        "| detector | shape | frames | errors | NaN/inf outputs | us/frame first block | last block | worst block | RSS before (KiB) | after | max | work counters, first -> last block |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for x in s {
         t.push_str(&format!(
-            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {} | {} | {} | {} |\n",
             x.detector,
+            x.shape.name(),
             x.frames,
             x.errors,
             x.bad_outputs,
@@ -209,19 +215,35 @@ pub fn soak_table(s: &[Soak]) -> String {
             x.last_us,
             x.worst_us,
             x.rss_before_kib,
-            x.rss_after_kib
+            x.rss_after_kib,
+            x.rss_max_kib,
+            work_text(x)
         ));
     }
     t
 }
 
-/// `faint soak` (one detector at a time, so that the memory readings are its own).
+/// `name: first -> last` for each work counter of a soak run.
+fn work_text(x: &Soak) -> String {
+    let (Some(a), Some(b)) = (x.blocks_work.first(), x.blocks_work.last()) else {
+        return String::new();
+    };
+    x.work_names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| format!("{n}: {:.3} -> {:.3}", a[i], b[i]))
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// `faint soak` (one detector at a time, so that the memory readings are its own). The
+/// results so far are written after each detector.
 pub fn soak_command(args: &SoakArgs) -> Result<()> {
     crate::cli::count("--frames", args.frames as usize, 1..=1 << 40)?;
     crate::cli::out_dir(&args.out)?;
     let mut all = Vec::new();
     for name in names(&args.detectors)? {
-        match run(name, Job::Soak(args.frames, args.seed))? {
+        match run(name, Job::Soak(args.frames, args.seed, args.shape))? {
             Outcome::Soak(s) => {
                 eprintln!(
                     "{name}: {} frames, {:.1} -> {:.1} us/frame",
@@ -231,13 +253,12 @@ pub fn soak_command(args: &SoakArgs) -> Result<()> {
             }
             Outcome::Fuzz(_) => bail!("internal: a fuzz outcome from a soak job"),
         }
+        crate::io::write_text(
+            args.out.join("soak.json"),
+            &serde_json::to_string_pretty(&all)?,
+        )?;
+        crate::io::write_text(args.out.join("soak.md"), &soak_table(&all))?;
     }
-    crate::io::write_text(
-        args.out.join("soak.json"),
-        &serde_json::to_string_pretty(&all)?,
-    )?;
-    let table = soak_table(&all);
-    crate::io::write_text(args.out.join("soak.md"), &table)?;
-    print!("{table}");
+    print!("{}", soak_table(&all));
     Ok(())
 }

@@ -11,7 +11,10 @@ use anyhow::{anyhow, bail, Context, Result};
 use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::cbmember::CbmemberConfig;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
-use faint_core::detect::dp::{DpConfig, Method};
+use faint_core::detect::dp::{
+    arnold_words, pulford_words, second_order_words, ArnoldDp, DpConfig, Method, PulfordDp,
+    SecondOrderDp,
+};
 use faint_core::detect::mht::MhtConfig;
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
@@ -23,7 +26,7 @@ use serde::Serialize;
 use serde_json::Value;
 
 use super::frames::{complex, plots, reals, Mode};
-use super::soak::{soak, Soak};
+use super::soak::{soak, Shape, Soak, WorkCounters};
 use super::{fuzz, Options, Tally, Target};
 use crate::detect::default_classic;
 use crate::reproduce::mht::{Classic, Mht, P as MHT_PLOTS};
@@ -117,6 +120,78 @@ pub fn small_phd(v: Variant) -> PhdConfig {
     c
 }
 
+/// [`Shape::Reduced`]'s PHD-TBD / PSO-PHD-TBD: an 8 x 8 x 4 cube over the preset's
+/// extent, 50 particles per target, 25 births (and at least 25 particles), at most 32
+/// particles in the swarm.
+pub fn reduced_phd(v: Variant) -> PhdConfig {
+    let mut c = SixTargets::new(9.0).config(v);
+    let g = &mut c.geometry;
+    let (r, d, a) = (
+        g.range_cell * g.n_range as f32,
+        g.doppler_cell * g.n_doppler as f32,
+        g.azimuth_cell_deg * g.n_azimuth as f32,
+    );
+    g.n_range = 8;
+    g.n_doppler = 8;
+    g.n_azimuth = 4;
+    g.range_cell = r / 8.0;
+    g.doppler_cell = d / 8.0;
+    g.azimuth_cell_deg = a / 4.0;
+    c.particles_per_target = 50;
+    c.birth.particles = 25;
+    c.min_particles = 25;
+    if let Some(p) = c.pso.as_mut() {
+        p.max_members = 32;
+    }
+    c
+}
+
+/// The CBMeMBer preset (`model`), and in [`Shape::Reduced`] on a 32 x 64 map over the
+/// preset's extent with `L_max = 100`, `L_min = 30` and 30 birth particles.
+pub fn cbmember_config(model: PointModel, shape: Shape) -> CbmemberConfig {
+    let mut c = CbmemberConfig {
+        model,
+        ..CbmemberConfig::rotor_uav()
+    };
+    if shape == Shape::Reduced {
+        let g = &mut c.geometry;
+        g.range_bin *= g.n_range as f32 / 32.0;
+        g.velocity_bin *= g.n_velocity as f32 / 64.0;
+        g.n_range = 32;
+        g.n_velocity = 64;
+        c.max_particles = 100;
+        c.min_particles = 30;
+        c.birth.particles = 30;
+    }
+    c
+}
+
+/// Side of [`Shape::Reduced`]'s DP-TBD images.
+pub const REDUCED_SIDE: usize = 32;
+
+type Arnold32 =
+    ArnoldDp<REDUCED_SIDE, 9, { sdp::HISTORY }, { arnold_words(REDUCED_SIDE, 9, sdp::HISTORY) }>;
+type Pulford32 =
+    PulfordDp<REDUCED_SIDE, 9, { sdp::HISTORY }, { pulford_words(REDUCED_SIDE, 9, sdp::HISTORY) }>;
+type Second32 = SecondOrderDp<
+    REDUCED_SIDE,
+    9,
+    { sdp::HISTORY },
+    { second_order_words(REDUCED_SIDE, 9, sdp::HISTORY) },
+>;
+
+// SAFETY: the same types as `scenario::dp`'s (integers, floats, bools, fieldless enums
+// whose first variant is 0), on a smaller image: their `unconfigured()` is all zeros.
+unsafe impl sdp::ZeroValid for Arnold32 {}
+// SAFETY: as above.
+unsafe impl sdp::ZeroValid for Pulford32 {}
+// SAFETY: as above.
+unsafe impl sdp::ZeroValid for Second32 {}
+
+fn image_reduced(rng: &mut Rng, _c: &DpConfig, mode: Mode) -> Vec<f32> {
+    reals(rng, REDUCED_SIDE * REDUCED_SIDE, mode, 1.5, false)
+}
+
 /// Builds two detectors on a thread with a large stack (the host filters are large
 /// values) and runs the campaign there.
 fn on_big_stack<F>(f: F) -> Result<Outcome>
@@ -144,8 +219,8 @@ fn pair<D>(
 pub enum Job {
     /// A fuzz campaign.
     Fuzz(Options),
-    /// A soak run: frames, seed.
-    Soak(u64, u64),
+    /// A soak run: frames, seed, configuration size.
+    Soak(u64, u64, Shape),
 }
 
 /// What a [`Job`] measured.
@@ -167,12 +242,12 @@ fn go<D, T>(
 where
     D: Detector<Frame = [T]> + ?Sized,
     D::Config: Serialize + serde::de::DeserializeOwned,
-    D::Report: std::fmt::Debug,
+    D::Report: std::fmt::Debug + WorkCounters,
 {
     let t = Target { name, base, frame };
     match *job {
         Job::Fuzz(opts) => Outcome::Fuzz(fuzz(&t, a.as_mut(), b.as_mut(), &opts)),
-        Job::Soak(frames, seed) => Outcome::Soak(soak(&t, a.as_mut(), frames, seed)),
+        Job::Soak(frames, seed, shape) => Outcome::Soak(soak(&t, a.as_mut(), frames, seed, shape)),
     }
 }
 
@@ -185,6 +260,7 @@ fn boxed2<D: faint_core::detect::dp::DpTrack + sdp::ZeroValid>(
 /// Runs `job` on the detector `name` (one of [`names`]).
 pub fn run(name: &str, job: Job) -> Result<Outcome> {
     let name: &'static str = crate::detect::find(name)?.name;
+    let reduced = matches!(job, Job::Soak(_, _, Shape::Reduced));
     on_big_stack(move || {
         let o = &job;
         Ok(match name {
@@ -244,7 +320,11 @@ pub fn run(name: &str, job: Job) -> Result<Outcome> {
                     "pso-phd-kmeans" => Variant::PsoKMeans,
                     _ => Variant::PsoDbscan,
                 };
-                let c = small_phd(v);
+                let c = if reduced {
+                    reduced_phd(v)
+                } else {
+                    small_phd(v)
+                };
                 go(name, to_value(&c), cube, pair(|| PhdHost::new(c, 0))?, o)
             }
             "cbmember" | "cbmember-doppler" => {
@@ -253,10 +333,12 @@ pub fn run(name: &str, job: Job) -> Result<Outcome> {
                 } else {
                     PointModel::DopplerOnly
                 };
-                let c = CbmemberConfig {
-                    model,
-                    ..CbmemberConfig::rotor_uav()
+                let shape = if reduced {
+                    Shape::Reduced
+                } else {
+                    Shape::Preset
                 };
+                let c = cbmember_config(model, shape);
                 go(
                     name,
                     to_value(&c),
@@ -272,12 +354,37 @@ pub fn run(name: &str, job: Job) -> Result<Outcome> {
                     _ => Method::SecondOrder,
                 };
                 let c = DpConfig::dim_point(m, 1);
-                match m {
-                    Method::Arnold => go(name, to_value(&c), image, boxed2::<sdp::Arnold9>(&c)?, o),
-                    Method::Pulford => {
-                        go(name, to_value(&c), image, boxed2::<sdp::Pulford9>(&c)?, o)
-                    }
-                    _ => go(name, to_value(&c), image, boxed2::<sdp::Second9>(&c)?, o),
+                match (m, reduced) {
+                    (Method::Arnold, true) => go(
+                        name,
+                        to_value(&c),
+                        image_reduced,
+                        boxed2::<Arnold32>(&c)?,
+                        o,
+                    ),
+                    (Method::Pulford, true) => go(
+                        name,
+                        to_value(&c),
+                        image_reduced,
+                        boxed2::<Pulford32>(&c)?,
+                        o,
+                    ),
+                    (_, true) => go(
+                        name,
+                        to_value(&c),
+                        image_reduced,
+                        boxed2::<Second32>(&c)?,
+                        o,
+                    ),
+                    _ => match m {
+                        Method::Arnold => {
+                            go(name, to_value(&c), image, boxed2::<sdp::Arnold9>(&c)?, o)
+                        }
+                        Method::Pulford => {
+                            go(name, to_value(&c), image, boxed2::<sdp::Pulford9>(&c)?, o)
+                        }
+                        _ => go(name, to_value(&c), image, boxed2::<sdp::Second9>(&c)?, o),
+                    },
                 }
             }
             other => bail!("unknown detector '{other}'"),
