@@ -836,7 +836,10 @@ impl<const N: usize> CrpfTbd<N> {
         self.rng = st.rng;
 
         let (mean, min) = self.estimates(count, best, arg);
-        self.prev[..m].copy_from_slice(z);
+        // `z` has `m <= MAX_BINS` bins (checked above): the zip copies all of them.
+        for (p, &v) in self.prev.iter_mut().zip(z) {
+            *p = v;
+        }
         self.prev_zz = zz;
         self.frame += 1;
         self.last = DopplerReport {
@@ -860,7 +863,10 @@ impl<const N: usize> CrpfTbd<N> {
         best: f32,
         arg: Option<usize>,
     ) -> (Option<[f32; 3]>, Option<[f32; 3]>) {
-        let (Some(a), Some(live)) = (arg, self.anc.get(..count)) else {
+        let (Some(best_x), Some(live)) = (
+            arg.and_then(|a| self.parts.get(a)).map(|p| p.x),
+            self.anc.get(..count),
+        ) else {
             return (None, None);
         };
         // max of -q ln C is at the min cost (on the ln-free path `log_c` holds d2 and
@@ -870,7 +876,7 @@ impl<const N: usize> CrpfTbd<N> {
         let n = self.int_exponent;
         // Doppler is averaged relative to the min-cost particle so the wrap at the band
         // edge does not split the mean.
-        let ref_fd = self.parts[a].x[0];
+        let ref_fd = best_x[0];
         let width = self.model.motion.band_width();
         // One loop per weight form (the form is not re-tested per particle).
         let (s, acc) = match n {
@@ -884,7 +890,7 @@ impl<const N: usize> CrpfTbd<N> {
             acc[1] / s,
             acc[2] / s,
         ];
-        (Some(mean), Some(self.parts[a].x))
+        (Some(mean), Some(best_x))
     }
 
     /// `sum_i w_i` and `sum_i w_i [fd_i - ref_fd (wrapped), fda_i, A_i]` over the particles

@@ -258,9 +258,11 @@ impl DopplerModel {
             first += m;
         }
         if !(0..m).contains(&first) {
+            // `m >= SPAN` (checked by `new`); the `max` only lets the optimiser see a
+            // divisor that is not zero.
             first = (b as i64)
                 .saturating_sub(HALF_SPAN as i64)
-                .rem_euclid(m as i64) as i32;
+                .rem_euclid(i64::from(m).max(1)) as i32;
         }
         (first as usize, i0, frac)
     }
