@@ -40,6 +40,7 @@ fn smoke_campaign_finds_nothing() {
         seed: 11,
         first: 0,
         out: "unused".into(),
+        input: None,
     };
     let tallies = fuzz_all(&args).unwrap();
     assert_eq!(tallies.len(), 14);
@@ -68,6 +69,7 @@ fn campaign_is_deterministic() {
         seed: 3,
         first: 5,
         out: "unused".into(),
+        input: None,
     };
     let a = fuzz_all(&args).unwrap();
     let b = fuzz_all(&args).unwrap();

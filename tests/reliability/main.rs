@@ -7,6 +7,7 @@
 
 mod campaign;
 mod findings;
+mod guided;
 
 #[test]
 fn checked_build() {

@@ -34,6 +34,11 @@ pub struct FuzzArgs {
     /// Output folder: `tally.json`, `tally.md` and one JSON file per finding.
     #[arg(long, default_value = "out/fuzz")]
     pub out: PathBuf,
+    /// Instead of a campaign, replay one coverage-guided input (a file of the `fuzz/`
+    /// targets, e.g. a crash) on the one detector named; a finding is written to `--out`
+    /// in the corpus format.
+    #[arg(long)]
+    pub input: Option<PathBuf>,
 }
 
 /// Arguments of `faint soak`.
@@ -169,6 +174,29 @@ pub fn fuzz_command(args: &FuzzArgs) -> Result<()> {
         );
     }
     crate::cli::out_dir(&args.out)?;
+    if let Some(input) = &args.input {
+        let [name] = names(&args.detectors)?[..] else {
+            bail!("--input replays on one detector: name exactly one");
+        };
+        let data = std::fs::read(input)
+            .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", input.display()))?;
+        let Some(f) = super::guided::finding(name, &data)? else {
+            println!("{name}: no finding");
+            return Ok(());
+        };
+        let kind = serde_json::to_value(f.kind)?;
+        let path = args.out.join(format!(
+            "{name}-{}-guided.json",
+            kind.as_str().unwrap_or("finding")
+        ));
+        crate::io::write_text(&path, &serde_json::to_string_pretty(&f)?)?;
+        bail!(
+            "{name}: {:?}: {} (written to {})",
+            f.kind,
+            f.message,
+            path.display()
+        );
+    }
     let tallies = fuzz_all(args)?;
     for t in &tallies {
         for (i, f) in t.findings.iter().enumerate() {

@@ -62,7 +62,8 @@ impl Mode {
     }
 }
 
-const EXTREMES: [f32; 8] = [
+/// Extreme finite values a frame can carry.
+pub const EXTREMES: [f32; 8] = [
     0.0,
     -0.0,
     f32::MIN_POSITIVE,
@@ -72,7 +73,8 @@ const EXTREMES: [f32; 8] = [
     f32::MAX,
     -f32::MAX,
 ];
-const BAD: [f32; 3] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY];
+/// The non-finite values.
+pub const BAD: [f32; 3] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY];
 
 /// `len` reals in `mode`; `scale` is the preset's noise level, `positive` makes the
 /// plausible values powers (`|x|^2`) rather than signed amplitudes.

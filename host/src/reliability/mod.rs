@@ -21,6 +21,7 @@
 
 pub mod cli;
 pub mod frames;
+pub mod guided;
 pub mod mutate;
 pub mod soak;
 pub mod targets;
@@ -80,6 +81,10 @@ pub struct Finding {
     pub mutated: Vec<String>,
     /// The configuration (JSON) of the case.
     pub config: Value,
+    /// The input of a coverage-guided finding (hex; [`guided`]), replayed through
+    /// [`guided::by_name`] instead of regenerated from `seed` and `case`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub input: Option<String>,
 }
 
 /// Counts of one campaign.
@@ -196,7 +201,7 @@ pub fn overflow_checks_on() -> bool {
 
 /// The report and the detections of the last step, as text (Debug prints the shortest
 /// representation that reads back to the same bits, so equal text is equal bits).
-fn outputs<D: Detector + ?Sized>(det: &D, report: &D::Report) -> String
+pub fn outputs<D: Detector + ?Sized>(det: &D, report: &D::Report) -> String
 where
     D::Report: Debug,
 {
@@ -303,6 +308,7 @@ fn run_case<D, T>(
         message,
         mutated: mutated.clone(),
         config: v.clone(),
+        input: None,
     };
     let Ok(cfg) = serde_json::from_value::<D::Config>(v.clone()) else {
         tally.rejected_parse += 1;
@@ -365,28 +371,13 @@ fn run_case<D, T>(
                 }
                 if let Some(out_a) = out_a {
                     tally.lockstep_frames += 1;
-                    match catch(|| b.step(&frame).map(|r| outputs(b, &r))) {
-                        Ok(Ok(out_b)) if out_b == out_a => {}
-                        Ok(Ok(out_b)) if had_error => {
-                            tally.record(finding(
-                                Kind::ChangedOnError,
-                                Some(k),
-                                Some(mode),
-                                format!("after a rejected frame: {out_a} | twin: {out_b}"),
-                            ));
-                            return;
-                        }
-                        other => {
-                            // The twin disagrees without an earlier error: the detector
-                            // is not deterministic for this configuration.
-                            tally.record(finding(
-                                Kind::ChangedOnError,
-                                Some(k),
-                                Some(mode),
-                                format!("twin disagrees with no rejected frame: {other:?}"),
-                            ));
-                            return;
-                        }
+                    let problem = match catch(|| twin_check(b, &frame, &out_a, had_error)) {
+                        Ok(p) => p,
+                        Err(msg) => Some((Kind::Panic, format!("the twin panicked: {msg}"))),
+                    };
+                    if let Some((kind, msg)) = problem {
+                        tally.record(finding(kind, Some(k), Some(mode), msg));
+                        return;
                     }
                 }
             }
@@ -394,8 +385,53 @@ fn run_case<D, T>(
     }
 }
 
-/// Re-runs the case of `f` (same seed, index and frame count) on its detector.
+/// Steps the twin `b` (stepped only on the frames the detector accepted) on `frame`,
+/// which the detector accepted with outputs `out_a` ([`outputs`]), and compares: the
+/// same bits, or a [`Kind::ChangedOnError`] (after a rejection, `had_error`: a rejected
+/// frame or configuration changed the state; without one: the detector is not
+/// deterministic).
+pub fn twin_check<D>(
+    b: &mut D,
+    frame: &D::Frame,
+    out_a: &str,
+    had_error: bool,
+) -> Option<(Kind, String)>
+where
+    D: Detector + ?Sized,
+    D::Report: Debug,
+{
+    let msg = match b.step(frame) {
+        Ok(r) => {
+            let out_b = outputs(b, &r);
+            if out_b == out_a {
+                return None;
+            }
+            if had_error {
+                format!("after a rejection: {out_a} | twin: {out_b}")
+            } else {
+                format!("twin disagrees with no rejection: {out_a} | twin: {out_b}")
+            }
+        }
+        Err(e) => format!("the twin rejected a frame the detector accepted: {e:?}"),
+    };
+    Some((Kind::ChangedOnError, msg))
+}
+
+/// Re-runs the case of `f` (same seed, index and frame count, or the same input bytes
+/// for a coverage-guided finding) on its detector.
 pub fn replay(f: &Finding) -> anyhow::Result<Tally> {
+    if let Some(hex) = &f.input {
+        let data = guided::from_hex(hex)?;
+        let mut t = Tally {
+            detector: f.detector.clone(),
+            cases: 1,
+            ..Tally::default()
+        };
+        if let Some(g) = guided::finding(&f.detector, &data)? {
+            t.record(g);
+        }
+        return Ok(t);
+    }
     let opts = Options {
         seed: f.seed,
         first: f.case,

@@ -13,7 +13,7 @@ use faint_core::rng::Rng;
 use serde_json::{Number, Value};
 
 /// Float replacements that stress the arithmetic.
-const FLOATS: [f64; 16] = [
+pub const FLOATS: [f64; 16] = [
     0.0,
     -0.0,
     1.175_494_4e-38,
@@ -33,7 +33,7 @@ const FLOATS: [f64; 16] = [
 ];
 
 /// Integer replacements.
-const INTS: [u64; 16] = [
+pub const INTS: [u64; 16] = [
     0,
     1,
     2,
