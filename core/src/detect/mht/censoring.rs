@@ -21,6 +21,7 @@
 
 use super::geometry::Geometry;
 use crate::model::plot::Plot;
+use crate::sort;
 
 /// Largest supported window `M`.
 pub const MAX_M: usize = 8;
@@ -55,6 +56,8 @@ pub const NODE_BUDGET_PER_PLOT: u32 = 64;
 pub struct Censor<const P: usize> {
     /// x-sorted plot indices of the scans, ring by scan index mod 2.
     order: [[u16; P]; 2],
+    /// Sort keys of the current scan, `(total-order bits of x) << 32 | index`.
+    keys: [u64; P],
     /// Gated pairs `(prev, cur)` between scan `s-1` and `s`, ring by `s mod MAX_M`,
     /// sorted by `prev`.
     pairs: [[(u16, u16); P]; MAX_M],
@@ -78,6 +81,7 @@ impl<const P: usize> Censor<P> {
         let () = Self::SHAPE;
         Self {
             order: [[0; P]; 2],
+            keys: [0; P],
             pairs: [[(0, 0); P]; MAX_M],
             npairs: [0; MAX_M],
             chain_budget: 4 * P as u32,
@@ -111,11 +115,16 @@ impl<const P: usize> Censor<P> {
         };
         let n = cur.len().min(P);
         // x-order of this scan
-        let ord = &mut self.order[s % 2];
-        for (i, o) in ord.iter_mut().enumerate().take(n) {
-            *o = i as u16;
+        // by x (`f32::total_cmp`), ties by index: one u64 per plot, a total order
+        let keys = &mut self.keys[..n];
+        for (i, (k, p)) in keys.iter_mut().zip(cur.iter()).enumerate() {
+            *k = (u64::from(total_order_bits(p.x)) << 32) | i as u64;
         }
-        ord[..n].sort_unstable_by(|&i, &j| cur[i as usize].x.total_cmp(&cur[j as usize].x));
+        sort::sort_unstable(keys);
+        let ord = &mut self.order[s % 2];
+        for (o, &k) in ord.iter_mut().zip(keys.iter()) {
+            *o = k as u16;
+        }
         let slot = s % MAX_M;
         self.npairs[slot] = 0;
         if s == 0 {
@@ -145,7 +154,8 @@ impl<const P: usize> Censor<P> {
                 }
             }
         }
-        list[..k].sort_unstable();
+        // (prev, cur) pairs are distinct: the order is total
+        sort::sort_unstable(&mut list[..k]);
         self.npairs[slot] = k as u16;
         st.pairs = k as u32;
         if s + 1 < m {
@@ -254,6 +264,46 @@ impl<const P: usize> Censor<P> {
             }
             chain[len] = b;
             self.grow(geom, scans, flags, s0, m, len + 1, chain, pts, budget, st);
+        }
+    }
+}
+
+/// The bits of `x` mapped so that unsigned order is `f32::total_cmp` order (negative
+/// values: all bits flipped; others: the sign bit set).
+#[inline(always)]
+fn total_order_bits(x: f32) -> u32 {
+    let b = x.to_bits();
+    b ^ ((((b as i32) >> 31) as u32) | 0x8000_0000)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::total_order_bits;
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn total_order_bits_is_total_cmp(a in any::<u32>(), b in any::<u32>()) {
+            let (x, y) = (f32::from_bits(a), f32::from_bits(b));
+            prop_assert_eq!(total_order_bits(x).cmp(&total_order_bits(y)), x.total_cmp(&y));
+        }
+    }
+
+    #[test]
+    fn total_order_bits_on_specials() {
+        let v = [
+            -f32::NAN,
+            f32::NEG_INFINITY,
+            -1.0,
+            -0.0,
+            0.0,
+            1e-40,
+            1.0,
+            f32::INFINITY,
+            f32::NAN,
+        ];
+        for w in v.windows(2) {
+            assert!(total_order_bits(w[0]) < total_order_bits(w[1]), "{:?}", w);
         }
     }
 }

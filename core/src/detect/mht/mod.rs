@@ -27,8 +27,8 @@
 //!   empty area: [`Error::InvalidConfig`] at construction.
 //!
 //! Memory (all fixed at compile time): the period's plots `NS x P` (12 B each) plus one
-//! flag byte each, the censoring pair ring `8 x P x 4 B`, the accumulator `R x A x 4 B`
-//! and `T` tracks of `NS` indices.
+//! flag byte each, the censoring pair ring `8 x P x 4 B` and x-sort keys `P x 8 B`, the
+//! accumulator `R x A x 4 B` and `T` tracks of `NS` indices.
 
 pub mod censoring;
 pub mod classic;
