@@ -138,9 +138,13 @@ impl<const P: usize> Censor<P> {
         let list = &mut self.pairs[slot];
         let mut k = 0usize;
         for (qi, q) in cur.iter().enumerate().take(n) {
-            let lo = pord.partition_point(|&i| prev[i as usize].x < q.x - gate);
+            // the order holds indices of `prev` only (`np <= prev.len()`)
+            let lo = pord
+                .partition_point(|&i| prev.get(usize::from(i)).is_some_and(|p| p.x < q.x - gate));
             for &pi in &pord[lo..] {
-                let p = &prev[pi as usize];
+                let Some(p) = prev.get(usize::from(pi)) else {
+                    continue;
+                };
                 if p.x > q.x + gate {
                     break;
                 }
@@ -155,7 +159,9 @@ impl<const P: usize> Censor<P> {
             }
         }
         // (prev, cur) pairs are distinct: the order is total
-        sort::sort_unstable(&mut list[..k]);
+        if let Some(found) = list.get_mut(..k) {
+            sort::sort_unstable(found);
+        }
         self.npairs[slot] = k as u16;
         st.pairs = k as u32;
         if s + 1 < m {
@@ -172,8 +178,7 @@ impl<const P: usize> Censor<P> {
             self.chain_budget,
             NODE_BUDGET_PER_PLOT.saturating_mul(P as u32),
         );
-        for i in 0..nfirst {
-            let (a, b) = self.pairs[first][i];
+        for &(a, b) in self.pairs[first].iter().take(nfirst) {
             chain[0] = a;
             chain[1] = b;
             self.grow(
@@ -255,8 +260,13 @@ impl<const P: usize> Censor<P> {
         }
         // pairs between scan s0+len-1 and s0+len, starting at chain[len-1]
         let slot = (s0 + len) % MAX_M;
-        let list = &self.pairs[slot][..usize::from(self.npairs[slot])];
-        let last = chain[len - 1];
+        let list = self.pairs[slot]
+            .get(..usize::from(self.npairs[slot]))
+            .unwrap_or(&[]);
+        // 2 <= len < m <= MAX_M
+        let (Some(&last), true) = (chain.get(len.wrapping_sub(1)), len < MAX_M) else {
+            return;
+        };
         let lo = list.partition_point(|&(a, _)| a < last);
         for &(a, b) in &list[lo..] {
             if a != last {
