@@ -52,6 +52,8 @@
 //! - [`existence`]: the two-state Markov chain of target existence and its fast samplers,
 //!   shared by the existence-carrying filters.
 //! - [`statistic`]: test statistics over K frames (`zeta_K`, `D_K`).
+//! - [`sort`]: a panic-free in-place unstable sort (introsort) for the detectors the
+//!   panic-never link checks cover.
 //! - [`scene`]: allocation-free scene synthesis (clutter plots, detections, power-cube
 //!   returns) shared by the host simulators, the golden cases and the firmware.
 //! - [`Complex32`]: complex samples, from `num-complex`.
@@ -75,6 +77,7 @@ pub mod model;
 pub mod particles;
 pub mod rng;
 pub mod scene;
+pub mod sort;
 pub mod statistic;
 
 pub use error::Error;

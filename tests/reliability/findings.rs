@@ -333,6 +333,28 @@ fn public_hough_functions_are_total() {
 }
 
 #[test]
+fn track_recovery_with_fewer_flag_rows_than_scans_is_total() {
+    // `dmht::recover` indexed `flags[s]` for every scan: fewer flag rows than scans
+    // panicked (found by the `panic-never-mht` link check). The scans without a flag row
+    // are now not associated.
+    use faint::core::detect::mht::dmht::{recover, Assoc};
+    use faint::core::detect::mht::{Peak, Track, NO_PLOT};
+    let g = Geometry::<64, 16>::for_area([0.0, 100.0, 0.0, 100.0]);
+    let a = [Plot::new(1.0, 50.0, 50.0); 4];
+    let scans: [&[Plot]; 3] = [&a, &a, &a];
+    let flags = [[1u8; 8]; 1];
+    let assoc = Assoc {
+        d_max: 200.0,
+        along_gate: 200.0,
+        lookback: true,
+    };
+    let mut tr = Track::<3>::default();
+    recover::<64, 16, 8, 3>(&g, Peak::default(), &scans, &flags, &assoc, &mut tr);
+    assert_eq!(tr.plots[1..], [NO_PLOT, NO_PLOT]);
+    assert!(tr.n_plots <= 1);
+}
+
+#[test]
 fn censoring_with_a_gate_wider_than_the_area_is_bounded() {
     // A gate of 1e10 m with m = 6 made every pair of plots a candidate and the chain
     // search visit up to P^5 partial chains (2.9 s for one scan; fuzz corpus

@@ -21,6 +21,7 @@
 
 use super::geometry::Geometry;
 use crate::model::plot::Plot;
+use crate::sort;
 
 /// Largest supported window `M`.
 pub const MAX_M: usize = 8;
@@ -55,6 +56,8 @@ pub const NODE_BUDGET_PER_PLOT: u32 = 64;
 pub struct Censor<const P: usize> {
     /// x-sorted plot indices of the scans, ring by scan index mod 2.
     order: [[u16; P]; 2],
+    /// Sort keys of the current scan, `(total-order bits of x) << 32 | index`.
+    keys: [u64; P],
     /// Gated pairs `(prev, cur)` between scan `s-1` and `s`, ring by `s mod MAX_M`,
     /// sorted by `prev`.
     pairs: [[(u16, u16); P]; MAX_M],
@@ -78,6 +81,7 @@ impl<const P: usize> Censor<P> {
         let () = Self::SHAPE;
         Self {
             order: [[0; P]; 2],
+            keys: [0; P],
             pairs: [[(0, 0); P]; MAX_M],
             npairs: [0; MAX_M],
             chain_budget: 4 * P as u32,
@@ -111,11 +115,16 @@ impl<const P: usize> Censor<P> {
         };
         let n = cur.len().min(P);
         // x-order of this scan
-        let ord = &mut self.order[s % 2];
-        for (i, o) in ord.iter_mut().enumerate().take(n) {
-            *o = i as u16;
+        // by x (`f32::total_cmp`), ties by index: one u64 per plot, a total order
+        let keys = &mut self.keys[..n];
+        for (i, (k, p)) in keys.iter_mut().zip(cur.iter()).enumerate() {
+            *k = (u64::from(total_order_bits(p.x)) << 32) | i as u64;
         }
-        ord[..n].sort_unstable_by(|&i, &j| cur[i as usize].x.total_cmp(&cur[j as usize].x));
+        sort::sort_unstable(keys);
+        let ord = &mut self.order[s % 2];
+        for (o, &k) in ord.iter_mut().zip(keys.iter()) {
+            *o = k as u16;
+        }
         let slot = s % MAX_M;
         self.npairs[slot] = 0;
         if s == 0 {
@@ -129,9 +138,13 @@ impl<const P: usize> Censor<P> {
         let list = &mut self.pairs[slot];
         let mut k = 0usize;
         for (qi, q) in cur.iter().enumerate().take(n) {
-            let lo = pord.partition_point(|&i| prev[i as usize].x < q.x - gate);
+            // the order holds indices of `prev` only (`np <= prev.len()`)
+            let lo = pord
+                .partition_point(|&i| prev.get(usize::from(i)).is_some_and(|p| p.x < q.x - gate));
             for &pi in &pord[lo..] {
-                let p = &prev[pi as usize];
+                let Some(p) = prev.get(usize::from(pi)) else {
+                    continue;
+                };
                 if p.x > q.x + gate {
                     break;
                 }
@@ -145,7 +158,10 @@ impl<const P: usize> Censor<P> {
                 }
             }
         }
-        list[..k].sort_unstable();
+        // (prev, cur) pairs are distinct: the order is total
+        if let Some(found) = list.get_mut(..k) {
+            sort::sort_unstable(found);
+        }
         self.npairs[slot] = k as u16;
         st.pairs = k as u32;
         if s + 1 < m {
@@ -162,8 +178,7 @@ impl<const P: usize> Censor<P> {
             self.chain_budget,
             NODE_BUDGET_PER_PLOT.saturating_mul(P as u32),
         );
-        for i in 0..nfirst {
-            let (a, b) = self.pairs[first][i];
+        for &(a, b) in self.pairs[first].iter().take(nfirst) {
             chain[0] = a;
             chain[1] = b;
             self.grow(
@@ -245,8 +260,13 @@ impl<const P: usize> Censor<P> {
         }
         // pairs between scan s0+len-1 and s0+len, starting at chain[len-1]
         let slot = (s0 + len) % MAX_M;
-        let list = &self.pairs[slot][..usize::from(self.npairs[slot])];
-        let last = chain[len - 1];
+        let list = self.pairs[slot]
+            .get(..usize::from(self.npairs[slot]))
+            .unwrap_or(&[]);
+        // 2 <= len < m <= MAX_M
+        let (Some(&last), true) = (chain.get(len.wrapping_sub(1)), len < MAX_M) else {
+            return;
+        };
         let lo = list.partition_point(|&(a, _)| a < last);
         for &(a, b) in &list[lo..] {
             if a != last {
@@ -254,6 +274,46 @@ impl<const P: usize> Censor<P> {
             }
             chain[len] = b;
             self.grow(geom, scans, flags, s0, m, len + 1, chain, pts, budget, st);
+        }
+    }
+}
+
+/// The bits of `x` mapped so that unsigned order is `f32::total_cmp` order (negative
+/// values: all bits flipped; others: the sign bit set).
+#[inline(always)]
+fn total_order_bits(x: f32) -> u32 {
+    let b = x.to_bits();
+    b ^ ((((b as i32) >> 31) as u32) | 0x8000_0000)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::total_order_bits;
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn total_order_bits_is_total_cmp(a in any::<u32>(), b in any::<u32>()) {
+            let (x, y) = (f32::from_bits(a), f32::from_bits(b));
+            prop_assert_eq!(total_order_bits(x).cmp(&total_order_bits(y)), x.total_cmp(&y));
+        }
+    }
+
+    #[test]
+    fn total_order_bits_on_specials() {
+        let v = [
+            -f32::NAN,
+            f32::NEG_INFINITY,
+            -1.0,
+            -0.0,
+            0.0,
+            1e-40,
+            1.0,
+            f32::INFINITY,
+            f32::NAN,
+        ];
+        for w in v.windows(2) {
+            assert!(total_order_bits(w[0]) < total_order_bits(w[1]), "{:?}", w);
         }
     }
 }

@@ -95,7 +95,7 @@ impl<const R: usize, const A: usize, const T: usize> ClassicHough<R, A, T> {
 
     /// Peaks of the last completed period, strongest first.
     pub fn peaks(&self) -> &[Peak] {
-        &self.peaks[..self.npeaks]
+        self.peaks.get(..self.npeaks).unwrap_or(&[])
     }
 
     /// One scan (the [`Detector::step`]). Invalid plots (non-finite, outside the area)

@@ -121,24 +121,37 @@ impl<const R: usize, const A: usize> Accumulator<R, A> {
         }
         const W: [u16; 3] = [1, 2, 1];
         for a in 0..A {
-            let interior_a = a > 0 && a + 1 < A;
+            // rows a-1, a, a+1 when a is an interior angle
+            let rows = match (
+                a.checked_sub(1).map(|i| self.acc.get(i)),
+                self.acc.get(a + 1),
+            ) {
+                (Some(Some(lo)), Some(hi)) => Some((lo, &self.acc[a], hi)),
+                _ => None,
+            };
             for r in 0..R {
                 let mut s = 0u16;
-                if interior_a && r > 0 && r + 1 < R {
-                    for (i, wa) in W.iter().enumerate() {
-                        let row = &self.acc[a + i - 1];
-                        s += wa
-                            * (u16::from(row[r - 1])
-                                + 2 * u16::from(row[r])
-                                + u16::from(row[r + 1]));
+                match rows {
+                    Some((lo, mid, hi)) if r > 0 && r + 1 < R => {
+                        // sum of W[i] (row[r-1] + 2 row[r] + row[r+1]); exact in u16
+                        // (at most 16 x 255)
+                        let row3 = |row: &[u8; R]| {
+                            u16::from(row[r - 1]) + 2 * u16::from(row[r]) + u16::from(row[r + 1])
+                        };
+                        s = row3(lo) + 2 * row3(mid) + row3(hi);
                     }
-                } else {
-                    for (i, wa) in W.iter().enumerate() {
-                        for (j, wr) in W.iter().enumerate() {
-                            if let Some(c) =
-                                Geometry::<R, A>::neighbour(r, a, j as isize - 1, i as isize - 1)
-                            {
-                                s += wa * wr * u16::from(self.acc[c / R][c % R]);
+                    _ => {
+                        for (i, wa) in W.iter().enumerate() {
+                            for (j, wr) in W.iter().enumerate() {
+                                let c = Geometry::<R, A>::neighbour(
+                                    r,
+                                    a,
+                                    j as isize - 1,
+                                    i as isize - 1,
+                                );
+                                if let Some(&v) = c.and_then(|c| Self::cell(&self.acc, c)) {
+                                    s += wa * wr * u16::from(v);
+                                }
                             }
                         }
                     }
@@ -146,6 +159,12 @@ impl<const R: usize, const A: usize> Accumulator<R, A> {
                 self.value[a][r] = s;
             }
         }
+    }
+
+    /// Cell `c = a R + r` of a grid; `None` past the grid.
+    #[inline(always)]
+    fn cell<T>(grid: &[[T; R]; A], c: usize) -> Option<&T> {
+        grid.get(c / R).and_then(|row| row.get(c % R))
     }
 
     /// Threshold and condense: the cells whose binary-integration count is `>= gamma`
@@ -183,8 +202,14 @@ impl<const R: usize, const A: usize> Accumulator<R, A> {
                 sp += 1;
                 while sp > 0 {
                     sp -= 1;
-                    let c = self.stack[sp] as usize;
-                    let (a, r) = (c / R, c % R);
+                    let Some(&c) = self.stack.get(sp) else {
+                        break;
+                    };
+                    let (a, r) = (c as usize / R, c as usize % R);
+                    // a < A for every stacked cell
+                    if a >= A {
+                        continue;
+                    }
                     best.cells = best.cells.saturating_add(1);
                     let v = self.value[a][r];
                     if v > best.value16 || (v == best.value16 && self.acc[a][r] > best.raw) {
@@ -202,7 +227,7 @@ impl<const R: usize, const A: usize> Accumulator<R, A> {
                                 continue;
                             };
                             let (na, nr) = (nc / R, nc % R);
-                            if self.stamp[na][nr] != 0 || self.acc[na][nr] < gamma {
+                            if na >= A || self.stamp[na][nr] != 0 || self.acc[na][nr] < gamma {
                                 continue;
                             }
                             if sp < CONDENSE_STACK {
@@ -231,8 +256,11 @@ impl<const R: usize, const A: usize> Accumulator<R, A> {
                     continue;
                 }
                 let mut i = n - 1;
-                while i > 0 && out[i - 1].value16 < out[i].value16 {
-                    out.swap(i - 1, i);
+                while i > 0 {
+                    match (out.get(i - 1), out.get(i)) {
+                        (Some(x), Some(y)) if x.value16 < y.value16 => out.swap(i - 1, i),
+                        _ => break,
+                    }
                     i -= 1;
                 }
             }
@@ -367,7 +395,7 @@ fn fit_consensus(ts: &[(f32, f32)], gate: f32, inl: &mut [(f32, f32)]) -> Option
             k += 1;
         }
     }
-    fit(&inl[..k])
+    fit(inl.get(..k).unwrap_or(&[]))
 }
 
 /// Total-least-squares line through points: `(theta, c)` with `theta in [0, pi)` the
@@ -412,7 +440,9 @@ fn tls(pts: &[(f32, f32)]) -> Option<(f32, f32)> {
 /// `|t - t_pred| <= along_gate` as well, the line is refined by total least squares
 /// through those plots and the motion refitted; pass 3 associates to the refined line,
 /// with the look-back.
-/// The track's `theta`, `c` are the refined line.
+/// The track's `theta`, `c` are the refined line. Scan `s` uses the flags `flags[s]`; the
+/// scans past `flags.len()`, past `NS`, and the plots past `P` of a scan are not
+/// associated.
 #[allow(clippy::too_many_arguments)]
 pub fn recover<const R: usize, const A: usize, const P: usize, const NS: usize>(
     geom: &Geometry<R, A>,
@@ -440,15 +470,16 @@ pub fn recover<const R: usize, const A: usize, const P: usize, const NS: usize>(
         track.n_plots = 0;
         track.n_effective = 0;
         let look = pass == 2 && assoc.lookback && pred.is_some();
-        for (si, scan) in scans.iter().enumerate().take(NS) {
+        let rows = scans.iter().zip(flags).zip(track.plots.iter_mut());
+        for (si, ((scan, fl), plot)) in rows.enumerate() {
             let tp = pred.map(|(al, be)| al + be * si as f32);
-            let mut best = (f32::INFINITY, NO_PLOT, false);
+            let mut best = (f32::INFINITY, NO_PLOT, false, (0.0f32, 0.0f32));
             for want_eff in [true, false] {
                 if !want_eff && (!look || best.1 != NO_PLOT) {
                     break;
                 }
-                for (k, p) in scan.iter().enumerate().take(P) {
-                    let eff = flags[si][k] & super::censoring::FLAG_EFFECTIVE != 0;
+                for (k, (p, &f)) in scan.iter().zip(fl).enumerate() {
+                    let eff = f & super::censoring::FLAG_EFFECTIVE != 0;
                     if eff != want_eff {
                         continue;
                     }
@@ -466,30 +497,34 @@ pub fn recover<const R: usize, const A: usize, const P: usize, const NS: usize>(
                         score = math::sqrt(d * d + e * e);
                     }
                     if score < best.0 {
-                        best = (score, k as u16, !want_eff);
+                        best = (score, k as u16, !want_eff, (p.x, p.y));
                     }
                 }
             }
             if best.1 != NO_PLOT {
-                track.plots[si] = best.1;
+                *plot = best.1;
                 track.n_plots += 1;
                 if best.2 {
                     track.lookback |= 1u64 << (si % 64);
-                } else {
+                } else if let (Some(q), Some(t)) = (xy.get_mut(nt), ts.get_mut(nt)) {
+                    // nt <= si < NS
                     track.n_effective += 1;
-                    let p = scan[usize::from(best.1)];
-                    xy[nt] = (p.x, p.y);
-                    ts[nt] = (si as f32, 0.0);
+                    *q = best.3;
+                    *t = (si as f32, 0.0);
                     nt += 1;
                 }
             }
         }
+        let (xy, ts) = (
+            xy.get(..nt).unwrap_or(&[]),
+            ts.get_mut(..nt).unwrap_or(&mut []),
+        );
         if pass == 2 {
             break;
         }
         if pass == 1 {
             // refine the line through the gated plots
-            if let Some((th, c2)) = tls(&xy[..nt]) {
+            if let Some((th, c2)) = tls(xy) {
                 track.theta = th;
                 track.c = c2;
                 cc = c2;
@@ -497,13 +532,13 @@ pub fn recover<const R: usize, const A: usize, const P: usize, const NS: usize>(
                 s = math::sin(th);
             }
         }
-        for (t, p) in ts[..nt].iter_mut().zip(&xy[..nt]) {
+        for (t, p) in ts.iter_mut().zip(xy) {
             t.1 = -p.0 * s + p.1 * c;
         }
         let f = if pass == 0 {
-            fit_consensus(&ts[..nt], assoc.along_gate, &mut inl)
+            fit_consensus(ts, assoc.along_gate, &mut inl)
         } else {
-            fit(&ts[..nt])
+            fit(ts)
         };
         match f {
             Some(f) => pred = Some(f),

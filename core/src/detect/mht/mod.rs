@@ -27,8 +27,8 @@
 //!   empty area: [`Error::InvalidConfig`] at construction.
 //!
 //! Memory (all fixed at compile time): the period's plots `NS x P` (12 B each) plus one
-//! flag byte each, the censoring pair ring `8 x P x 4 B`, the accumulator `R x A x 4 B`
-//! and `T` tracks of `NS` indices.
+//! flag byte each, the censoring pair ring `8 x P x 4 B` and x-sort keys `P x 8 B`, the
+//! accumulator `R x A x 4 B` and `T` tracks of `NS` indices.
 
 pub mod censoring;
 pub mod classic;
@@ -45,6 +45,48 @@ use crate::detect::{Detection, Detector, ScoreKind, TrackInfo, Validate};
 use crate::model::plot::Plot;
 use crate::{math, Error, Result};
 use censoring::{Censor, FLAG_EFFECTIVE};
+
+/// Kept plots of scan `s` of a period store (`counts[s] <= P`; empty past the store).
+fn kept<'a, const P: usize, const NS: usize>(
+    plots: &'a [[Plot; P]; NS],
+    counts: &[u16; NS],
+    s: usize,
+) -> &'a [Plot] {
+    match (plots.get(s), counts.get(s)) {
+        (Some(p), Some(&n)) => p.get(..usize::from(n)).unwrap_or(&[]),
+        _ => &[],
+    }
+}
+
+/// The first `ns` scans of a period store: `(plots, flags, kept count)` each.
+fn period<'a, const P: usize, const NS: usize>(
+    plots: &'a [[Plot; P]; NS],
+    flags: &'a [[u8; P]; NS],
+    counts: &'a [u16; NS],
+    ns: usize,
+) -> impl Iterator<Item = (&'a [Plot; P], &'a [u8; P], usize)> + 'a {
+    plots
+        .iter()
+        .zip(flags)
+        .zip(counts)
+        .take(ns)
+        .map(|((p, f), &n)| (p, f, usize::from(n)))
+}
+
+/// The effective plots among the first `n` of a scan, with their indices.
+fn effective<'a, const P: usize>(
+    plots: &'a [Plot; P],
+    flags: &'a [u8; P],
+    n: usize,
+) -> impl Iterator<Item = (&'a Plot, usize)> + 'a {
+    plots
+        .iter()
+        .zip(flags)
+        .take(n)
+        .enumerate()
+        .filter(|(_, (_, &f))| f & FLAG_EFFECTIVE != 0)
+        .map(|(k, (p, _))| (p, k))
+}
 
 /// True when the plot is finite and inside `[x_min, x_max] x [y_min, y_max]`.
 #[inline]
@@ -306,10 +348,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
 
     /// Kept plots of scan `s` of the current (or just completed) period.
     pub fn scan_plots(&self, s: usize) -> &[Plot] {
-        match (self.plots.get(s), self.counts.get(s)) {
-            (Some(p), Some(&n)) => &p[..usize::from(n)],
-            _ => &[],
-        }
+        kept(&self.plots, &self.counts, s)
     }
 
     /// True when plot `k` of scan `s` is in `S_ep`.
@@ -324,13 +363,16 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     pub fn effective_count(&self, s: usize) -> usize {
         let n = self.counts.get(s).map_or(0, |&n| usize::from(n));
         self.flags.get(s).map_or(0, |f| {
-            f[..n].iter().filter(|&&b| b & FLAG_EFFECTIVE != 0).count()
+            f.iter()
+                .take(n)
+                .filter(|&&b| b & FLAG_EFFECTIVE != 0)
+                .count()
         })
     }
 
     /// Confirmed tracks of the last completed period, strongest peak first.
     pub fn tracks(&self) -> &[Track<NS>] {
-        &self.tracks[..self.ntracks]
+        self.tracks.get(..self.ntracks).unwrap_or(&[])
     }
 
     /// One scan of plots (the [`Detector::step`]). See the module doc for the handling of
@@ -363,14 +405,15 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
             }
         }
         self.counts[s] = n as u16;
-        self.flags[s][..n].fill(0);
+        if let Some(f) = self.flags[s].get_mut(..n) {
+            f.fill(0);
+        }
         rep.plots_kept = n as u16;
         // stage 2: censoring of the window ending at s
         {
             let plots = &self.plots;
             let counts = &self.counts;
-            let scans: [&[Plot]; NS] =
-                core::array::from_fn(|i| &plots[i][..usize::from(counts[i])]);
+            let scans: [&[Plot]; NS] = core::array::from_fn(|i| kept(plots, counts, i));
             rep.censor = self.censor.step(
                 &self.msht,
                 &scans[..=s],
@@ -418,20 +461,18 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     /// Stage 3, the part independent of `gamma_1`: DMHT geometry, binary integration and
     /// smoothing of `S_ep`.
     fn integrate(&mut self) -> PeriodSummary {
-        let ns = self.cfg.n_scans;
+        // n_scans <= NS (configure checks it)
+        let ns = self.cfg.n_scans.min(NS);
         let mut det = PeriodSummary::default();
         // centroid and extent of S_ep (f64-free: two-pass in f32 about the area centre)
         let (ax, ay) = self.msht.origin();
         let (mut sx, mut sy, mut ne) = (0.0f32, 0.0f32, 0u32);
-        for s in 0..ns {
-            let n = usize::from(self.counts[s]);
+        for (plots, flags, n) in period(&self.plots, &self.flags, &self.counts, ns) {
             det.pre_plots += n as u32;
-            for k in 0..n {
-                if self.flags[s][k] & FLAG_EFFECTIVE != 0 {
-                    sx += self.plots[s][k].x - ax;
-                    sy += self.plots[s][k].y - ay;
-                    ne += 1;
-                }
+            for (p, _) in effective(plots, flags, n) {
+                sx += p.x - ax;
+                sy += p.y - ay;
+                ne += 1;
             }
         }
         det.effective_plots = ne;
@@ -445,14 +486,11 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
         let x0 = ax + sx / ne as f32;
         let y0 = ay + sy / ne as f32;
         let mut r2 = 0.0f32;
-        for s in 0..ns {
-            for k in 0..usize::from(self.counts[s]) {
-                if self.flags[s][k] & FLAG_EFFECTIVE != 0 {
-                    let p = self.plots[s][k];
-                    let d2 = (p.x - x0) * (p.x - x0) + (p.y - y0) * (p.y - y0);
-                    if d2 > r2 {
-                        r2 = d2;
-                    }
+        for (plots, flags, n) in period(&self.plots, &self.flags, &self.counts, ns) {
+            for (p, _) in effective(plots, flags, n) {
+                let d2 = (p.x - x0) * (p.x - x0) + (p.y - y0) * (p.y - y0);
+                if d2 > r2 {
+                    r2 = d2;
                 }
             }
         }
@@ -462,13 +500,11 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
         det.origin = (x0, y0);
         det.drho = self.dmht.drho();
         // binary integration of S_ep (eq. 7)
-        for s in 0..ns {
+        for (s, (plots, flags, n)) in period(&self.plots, &self.flags, &self.counts, ns).enumerate()
+        {
             let tag = (s + 1) as u8;
-            for k in 0..usize::from(self.counts[s]) {
-                if self.flags[s][k] & FLAG_EFFECTIVE != 0 {
-                    let p = self.plots[s][k];
-                    self.acc.add_point(&self.dmht, tag, p.x, p.y);
-                }
+            for (p, _) in effective(plots, flags, n) {
+                self.acc.add_point(&self.dmht, tag, p.x, p.y);
             }
         }
         self.acc.finish(self.cfg.smooth);
@@ -478,7 +514,8 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     /// Stage 3, the part that depends on `gamma_1`: threshold, condensing, track recovery
     /// and confirmation (an empty accumulator gives no peaks).
     fn extract(&mut self, gamma1: u8, mut det: PeriodSummary) -> PeriodSummary {
-        let ns = self.cfg.n_scans;
+        // n_scans <= NS (configure checks it)
+        let ns = self.cfg.n_scans.min(NS);
         det.condense = self.acc.condense(gamma1, &mut self.peaks);
         // track recovery
         let assoc = dmht::Assoc {
@@ -488,13 +525,14 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
         };
         let plots = &self.plots;
         let counts = &self.counts;
-        let scans: [&[Plot]; NS] = core::array::from_fn(|i| &plots[i][..usize::from(counts[i])]);
+        let scans: [&[Plot]; NS] = core::array::from_fn(|i| kept(plots, counts, i));
         let mut nt = 0usize;
-        for i in 0..usize::from(det.condense.peaks) {
+        for i in 0..usize::from(det.condense.peaks).min(T) {
+            let pk = self.peaks[i];
             let mut tr = Track::<NS>::default();
             dmht::recover::<R, A, P, NS>(
                 &self.dmht,
-                self.peaks[i],
+                pk,
                 &scans[..ns],
                 &self.flags,
                 &assoc,
@@ -505,10 +543,10 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
                 det.short += 1;
                 continue;
             }
-            let claimed = (0..ns)
-                .filter(|&s| {
-                    tr.plots[s] != NO_PLOT
-                        && self.tracks[..nt].iter().any(|o| o.plots[s] == tr.plots[s])
+            let tracks = self.tracks.get(..nt).unwrap_or(&[]);
+            let claimed = (tr.plots.iter().enumerate().take(ns))
+                .filter(|&(s, &k)| {
+                    k != NO_PLOT && tracks.iter().any(|o| o.plots.get(s) == Some(&k))
                 })
                 .count();
             let dup = 2 * claimed > usize::from(tr.n_plots);
@@ -517,19 +555,16 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
                 continue;
             }
             if self.cfg.residual && nt > 0 {
-                let pk = self.peaks[i];
                 let (r, a) = (usize::from(pk.r), usize::from(pk.a));
                 let mut resid = 0u8;
-                for s in 0..ns {
-                    let tracks = &self.tracks[..nt];
-                    let hit = (0..usize::from(self.counts[s])).any(|k| {
-                        if self.flags[s][k] & FLAG_EFFECTIVE == 0
-                            || (usize::from(tr.plots[s]) == k
-                                && tracks.iter().any(|o| o.plots[s] == tr.plots[s]))
+                let scans = period(&self.plots, &self.flags, &self.counts, ns);
+                for (s, ((plots, flags, n), &own)) in scans.zip(tr.plots.iter()).enumerate() {
+                    let hit = effective(plots, flags, n).any(|(p, k)| {
+                        if usize::from(own) == k
+                            && tracks.iter().any(|o| o.plots.get(s) == Some(&own))
                         {
                             return false;
                         }
-                        let p = self.plots[s][k];
                         let (xq, yq) = self.dmht.quantise(p.x, p.y);
                         self.dmht.rho_index_q(xq, yq, a) == r
                     });
@@ -540,8 +575,10 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
                     continue;
                 }
             }
-            self.tracks[nt] = tr;
-            nt += 1;
+            if let Some(t) = self.tracks.get_mut(nt) {
+                *t = tr;
+                nt += 1;
+            }
         }
         self.ntracks = nt;
         det.tracks = nt as u16;
