@@ -376,10 +376,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         }
     }
 
-    /// `J` of one row when `g` is separable: `J(d) = max_ey [GY(ey) + Hx(d - (0, ey), dx)]`,
-    /// `Hx(p_y, dx) = max_ex [I(p) << 4 + GX(ex)]` (row maxima shared by the states). The
-    /// keys carry `(ey + 1) << 2 | (ex + 1)`, ordered like the candidate index `j` (both
-    /// ascend in `e`), so the winner and its pointer are those of the plain 2-D max.
+    /// `J` of one row when `g` is separable ([`Self::j_cell_sep`] per pixel).
     #[inline(always)]
     fn j_row_sep(
         src: &[[C; QB]; M],
@@ -387,64 +384,239 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         gk: &[i32; 6],
         mut push: impl FnMut(u32, u32),
     ) {
-        let lay = &Self::LAY;
-        let n = Self::N;
         let gk = *gk;
         for (cell, out) in src.iter().zip(dst.iter_mut()) {
-            // hx[p_y][dx] over ex with p_x = dx - ex inside the window
-            let mut hx = [[FLOOR_KEY; 5]; 5];
-            for (pyi, hrow) in hx.iter_mut().enumerate().take(n) {
-                for (dxi, h) in hrow.iter_mut().enumerate().take(n) {
-                    // (`first`: the first candidate starts the max; constant once unrolled)
-                    let (mut v, mut first) = (FLOOR_KEY, true);
-                    for (cx, &gx) in gk.iter().enumerate().take(3) {
-                        let pxi = (dxi + 1).wrapping_sub(cx);
-                        if pxi < n {
-                            let i = cell.get(pyi * n + pxi).map_or(C::FLOOR, |c| c.get());
-                            let key = (i << 4) + gx;
-                            v = if first || key > v { key } else { v };
-                            first = false;
-                        }
-                    }
-                    *h = v;
-                }
-            }
-            let (mut acc, mut prev) = (0u32, 0i32);
-            for (d, o) in out.iter_mut().enumerate() {
-                let (dyi, dxi) = (d / n, d % n);
+            Self::j_cell_sep(cell, &gk, out, &mut push);
+        }
+    }
+
+    /// `J` of one pixel when `g` is separable: `J(d) = max_ey [GY(ey) + Hx(d - (0, ey), dx)]`,
+    /// `Hx(p_y, dx) = max_ex [I(p) << 4 + GX(ex)]` (row maxima shared by the states). The
+    /// keys carry `(ey + 1) << 2 | (ex + 1)`, ordered like the candidate index `j` (both
+    /// ascend in `e`), so the winner and its pointer are those of the plain 2-D max.
+    #[inline(always)]
+    fn j_cell_sep(
+        cell: &[C; QB],
+        gk: &[i32; 6],
+        out: &mut [C; QB],
+        push: &mut impl FnMut(u32, u32),
+    ) {
+        let lay = &Self::LAY;
+        let n = Self::N;
+        // hx[p_y][dx] over ex with p_x = dx - ex inside the window
+        let mut hx = [[FLOOR_KEY; 5]; 5];
+        for (pyi, hrow) in hx.iter_mut().enumerate().take(n) {
+            for (dxi, h) in hrow.iter_mut().enumerate().take(n) {
+                // (`first`: the first candidate starts the max; constant once unrolled)
                 let (mut v, mut first) = (FLOOR_KEY, true);
-                for (cy, &gy) in gk.iter().skip(3).enumerate() {
-                    let pyi = (dyi + 1).wrapping_sub(cy);
-                    if pyi < n {
-                        let h = hx
-                            .get(pyi)
-                            .and_then(|h| h.get(dxi))
-                            .map_or(FLOOR_KEY, |&h| h);
-                        let key = h + gy;
+                for (cx, &gx) in gk.iter().enumerate().take(3) {
+                    let pxi = (dxi + 1).wrapping_sub(cx);
+                    if pxi < n {
+                        let i = cell.get(pyi * n + pxi).map_or(C::FLOOR, |c| c.get());
+                        let key = (i << 4) + gx;
                         v = if first || key > v { key } else { v };
                         first = false;
                     }
                 }
-                *o = C::sat(v >> 4);
-                // the chunk's code, sum of j suffix[d] (the candidate index j of the
-                // winner's code, from a table; states 2i - 1, 2i of one chunk as a pair)
-                let last = lay.chunk_last.get(d).copied().unwrap_or(false);
-                let paired = d % 2 == 1 && d + 1 < QB && !last;
-                if d % 2 == 0 && d > 0 && !lay.chunk_last.get(d - 1).copied().unwrap_or(true) {
-                    let c = ((prev & 15) | ((v & 15) << 4)) as usize;
-                    let term = lay.jpair.get(d / 2 - 1).map_or(0, |t| t[c]);
-                    acc = acc.wrapping_add(term);
-                } else if !paired {
-                    let term = lay.jterm.get(d).map_or(0, |t| t[(v & 15) as usize]);
-                    acc = acc.wrapping_add(term);
+                *h = v;
+            }
+        }
+        let (mut acc, mut prev) = (0u32, 0i32);
+        for (d, o) in out.iter_mut().enumerate() {
+            let (dyi, dxi) = (d / n, d % n);
+            let (mut v, mut first) = (FLOOR_KEY, true);
+            for (cy, &gy) in gk.iter().skip(3).enumerate() {
+                let pyi = (dyi + 1).wrapping_sub(cy);
+                if pyi < n {
+                    let h = hx
+                        .get(pyi)
+                        .and_then(|h| h.get(dxi))
+                        .map_or(FLOOR_KEY, |&h| h);
+                    let key = h + gy;
+                    v = if first || key > v { key } else { v };
+                    first = false;
                 }
-                prev = v;
-                if last {
-                    push(acc, u32::from(lay.chunk_bits.get(d).copied().unwrap_or(1)));
-                    acc = 0;
+            }
+            *o = C::sat(v >> 4);
+            // the chunk's code, sum of j suffix[d] (the candidate index j of the
+            // winner's code, from a table; states 2i - 1, 2i of one chunk as a pair)
+            let last = lay.chunk_last.get(d).copied().unwrap_or(false);
+            let paired = d % 2 == 1 && d + 1 < QB && !last;
+            if d % 2 == 0 && d > 0 && !lay.chunk_last.get(d - 1).copied().unwrap_or(true) {
+                let c = ((prev & 15) | ((v & 15) << 4)) as usize;
+                let term = lay.jpair.get(d / 2 - 1).map_or(0, |t| t[c]);
+                acc = acc.wrapping_add(term);
+            } else if !paired {
+                let term = lay.jterm.get(d).map_or(0, |t| t[(v & 15) as usize]);
+                acc = acc.wrapping_add(term);
+            }
+            prev = v;
+            if last {
+                push(acc, u32::from(lay.chunk_bits.get(d).copied().unwrap_or(1)));
+                acc = 0;
+            }
+        }
+    }
+
+    /// `J` of merit row `rr` (`q_B = 9`, separable `g`) written at the target pixels
+    /// `t = t' + d`: `up`, `mid`, `dn` are the padded target rows `rr - 1`, `rr`, `rr + 1`
+    /// (`M + 2` cells, pixel `x` at `x + 1`), so state `d = (dx, dy)` of pixel `x` goes to
+    /// cell `x + 1 + dx` of row `rr + dy`.
+    #[inline(always)]
+    fn j_row_fast(
+        src: &[[C; QB]; M],
+        (up, mid, dn): (&mut [[C; QB]], &mut [[C; QB]], &mut [[C; QB]]),
+        gk: &[i32; 6],
+        mut push: impl FnMut(u32, u32),
+    ) {
+        let gk = *gk;
+        let mut o = [C::ZERO; QB];
+        for (x, cell) in src.iter().enumerate() {
+            Self::j_cell_sep(cell, &gk, &mut o, &mut push);
+            for (dyi, row) in [&mut *up, &mut *mid, &mut *dn].into_iter().enumerate() {
+                if let Some(t) = row.get_mut(x..x + 3) {
+                    for (dxi, tc) in t.iter_mut().enumerate() {
+                        let s = 3 * dyi + dxi;
+                        if let (Some(c), Some(&v)) = (tc.get_mut(s), o.get(s)) {
+                            *c = v;
+                        }
+                    }
                 }
             }
         }
+    }
+
+    /// [`Self::j_row_fast`] of merit row `rr` into the ring (see [`Self::run_fast`]).
+    #[inline(always)]
+    fn jrow_fast(
+        states: &[[[C; QB]; M]; M],
+        ring: &mut [[C; QB]],
+        rr: usize,
+        gk: &[i32; 6],
+        bw: &mut Option<BitWriter<'_>>,
+    ) {
+        let rs = M + 2;
+        let Some(src) = states.get(rr) else {
+            return;
+        };
+        let (s0, rest) = ring.split_at_mut(rs.min(ring.len()));
+        let (s1, s2) = rest.split_at_mut(rs.min(rest.len()));
+        let rows = match rr % 3 {
+            0 => (s2, s0, s1),
+            1 => (s0, s1, s2),
+            _ => (s1, s2, s0),
+        };
+        match bw.as_mut() {
+            Some(w) => Self::j_row_fast(src, rows, gk, |c, b| w.push(c, b)),
+            None => Self::j_row_fast(src, rows, gk, |_, _| {}),
+        }
+    }
+
+    /// The fast frame (`q_B = 9`, separable `g`, `k >= 3`): `J` at the target pixels in
+    /// three padded ring rows (row `y` in slot `y mod 3`, within `jring`), the new merits
+    /// one contiguous cell per pixel. Sources outside the image stay at the floor (cells
+    /// never written). Returns the best stored merit and its pixel, and the clamp count.
+    fn run_fast(
+        &mut self,
+        frame: &[f32],
+        sub: i32,
+        slow: bool,
+        gk: &[i32; 6],
+        k: u32,
+    ) -> (i32, (u16, u16), u32) {
+        let floor = C::sat(C::FLOOR);
+        let rs = M + 2;
+        let Self {
+            s: states,
+            jring,
+            zrow,
+            quant,
+            ptr,
+            ..
+        } = self;
+        let slot = (k.saturating_sub(3) as usize) % Self::LP.max(1);
+        let words: &mut [u32] = ptr
+            .get_mut(slot * Self::WF..(slot + 1) * Self::WF)
+            .unwrap_or(&mut []);
+        let mut bw = if words.is_empty() {
+            None
+        } else {
+            Some(BitWriter::new(words))
+        };
+        let ring = jring.as_flattened_mut();
+        let ring = ring.get_mut(..3 * rs).unwrap_or(&mut []);
+        // the cells no source writes: pixel 0's states dx = +1, pixel M - 1's dx = -1
+        for slot in ring.chunks_exact_mut(rs) {
+            if let Some(a) = slot.get_mut(1) {
+                for i in [2, 5, 8] {
+                    if let Some(c) = a.get_mut(i) {
+                        *c = floor;
+                    }
+                }
+            }
+            if let Some(b) = slot.get_mut(M) {
+                for i in [0, 3, 6] {
+                    if let Some(c) = b.get_mut(i) {
+                        *c = floor;
+                    }
+                }
+            }
+        }
+        // row 0's states dy = +1
+        for c in ring.iter_mut().take(M + 1).skip(1) {
+            for i in [6, 7, 8] {
+                if let Some(c) = c.get_mut(i) {
+                    *c = floor;
+                }
+            }
+        }
+        let mut clamped = 0;
+        let (mut best, mut bxy) = (i32::MIN, (0u16, 0u16));
+        Self::jrow_fast(states, ring, 0, gk, &mut bw);
+        for (y, src) in frame.chunks_exact(M).enumerate() {
+            if y + 1 < M {
+                Self::jrow_fast(states, ring, y + 1, gk, &mut bw);
+            }
+            clamped += quant.row(src, sub, slow, zrow);
+            let Some(slot) = ring.get_mut((y % 3) * rs..(y % 3 + 1) * rs) else {
+                continue;
+            };
+            if y + 1 == M {
+                // the last row's states dy = -1
+                for c in slot.iter_mut().take(M + 1).skip(1) {
+                    for i in [0, 1, 2] {
+                        if let Some(c) = c.get_mut(i) {
+                            *c = floor;
+                        }
+                    }
+                }
+            }
+            let Some(row) = states.get_mut(y) else {
+                continue;
+            };
+            let (mut rb, mut rx) = (i32::MIN, 0usize);
+            let cells = slot.get(1..).unwrap_or(&[]);
+            for (x, ((cell, &zq), j)) in row.iter_mut().zip(zrow.iter()).zip(cells).enumerate() {
+                let mut pb = i32::MIN;
+                for (c, jv) in cell.iter_mut().zip(j) {
+                    *c = C::sat(zq + jv.get());
+                    let v = c.get();
+                    pb = if v > pb { v } else { pb };
+                }
+                if pb > rb {
+                    rb = pb;
+                    rx = x;
+                }
+            }
+            if rb > best {
+                best = rb;
+                bxy = (rx as u16, y as u16);
+            }
+        }
+        if let Some(w) = bw {
+            w.finish();
+        }
+        (best, bxy, clamped)
     }
 
     fn run(&mut self, frame: &[f32], slow: bool) {
@@ -469,6 +641,11 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             let r = Self::R;
             let n = Self::N;
             let plain = k == 2;
+            if let (Some(gk), true) = (self.sep, QB == 9 && !plain && M >= 3) {
+                let (b, xy, c) = self.run_fast(frame, sub, slow, &gk, k);
+                self.tally.advance(sub, b, xy, c);
+                return;
+            }
             let slot = if k >= 3 {
                 ((k - 3) as usize) % Self::LP.max(1)
             } else {
@@ -699,5 +876,60 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
 
     fn best(&self) -> Option<TrackEnd> {
         self.ends.as_slice().first().copied()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{second_order_words, DpConfig, Method, Transition};
+    use super::{MeritCell, SecondOrderDp};
+    use crate::detect::Detector;
+    use crate::rng::Rng;
+
+    /// The fast frames (separable `g`, `J` at the target pixels) equal the general 2-D
+    /// path exactly: merits, back-pointer words and the best pixel, over frames with
+    /// saturating and clamped values.
+    fn fast_equals_general<C: MeritCell, const M: usize, const W: usize>(lsb: f32, seed: u64) {
+        for transition in [Transition::Gaussian, Transition::Hard] {
+            let mut cfg = DpConfig::dim_point(Method::SecondOrder, 1);
+            cfg.transition = transition;
+            cfg.lsb = lsb;
+            let mut a = SecondOrderDp::<M, 9, 5, W, C>::new(cfg).unwrap_or_else(|_| unreachable!());
+            let mut b = a.clone();
+            assert!(a.sep.is_some());
+            b.sep = None;
+            let mut rng = Rng::seed_from_u64(seed);
+            let mut z = [0f32; 4096];
+            for k in 0..9 {
+                for v in z.iter_mut().take(M * M) {
+                    *v = 1.5 * rng.normal();
+                    if rng.bernoulli(0.05) {
+                        *v *= 40.0;
+                    }
+                    if k == 4 && rng.bernoulli(0.02) {
+                        *v = if rng.bernoulli(0.5) { 1e30 } else { -1e30 };
+                    }
+                }
+                let ra = a.step(&z[..M * M]);
+                let rb = b.step(&z[..M * M]);
+                assert_eq!(ra.is_ok(), rb.is_ok());
+                assert!(a.s == b.s, "merits, frame {k}");
+                assert!(a.ptr == b.ptr, "pointers, frame {k}");
+                assert_eq!(a.tally.best_raw, b.tally.best_raw, "frame {k}");
+                assert_eq!(a.tally.best_xy, b.tally.best_xy, "frame {k}");
+            }
+        }
+    }
+
+    #[test]
+    fn fast_frames_equal_the_general_path() {
+        for seed in 0..3 {
+            fast_equals_general::<i16, 12, { second_order_words(12, 9, 5) }>(0.0625, seed);
+            fast_equals_general::<i8, 12, { second_order_words(12, 9, 5) }>(0.0625, seed);
+            fast_equals_general::<i16, 7, { second_order_words(7, 9, 5) }>(0.0625, seed);
+            fast_equals_general::<i8, 16, { second_order_words(16, 9, 5) }>(0.5, seed);
+            fast_equals_general::<i16, 16, { second_order_words(16, 9, 5) }>(0.001, seed);
+            fast_equals_general::<i16, 3, { second_order_words(3, 9, 5) }>(0.0625, seed);
+        }
     }
 }
