@@ -188,6 +188,199 @@ pub(crate) const fn layout(qb: usize) -> Layout {
     l
 }
 
+/// Pointer-code tables of the Cortex-M4 `J` row ([`j_row_asm`], `q_B = 9`): the code is
+/// the sum of `jterm[d][c_d]` over the states, looked up as `jterm[8]` (16 words) and the
+/// pairs `(0, 1)`, `(3, 4)`, `(6, 7)`, `(2, 5)` (256 words each, index `c_a | c_b << 4`).
+#[cfg_attr(not(target_arch = "arm"), allow(dead_code))]
+static ATAB: [u32; 16 + 4 * 256] = atab();
+
+const fn atab() -> [u32; 16 + 4 * 256] {
+    let l = layout(9);
+    let mut t = [0u32; 16 + 4 * 256];
+    let mut c = 0;
+    while c < 16 {
+        t[c] = l.jterm[8][c];
+        c += 1;
+    }
+    let pairs = [(0, 1), (3, 4), (6, 7), (2, 5)];
+    let mut p = 0;
+    while p < 4 {
+        let (a, b) = pairs[p];
+        let mut c = 0;
+        while c < 256 {
+            t[16 + 256 * p + c] = l.jterm[a][c & 15] + l.jterm[b][c >> 4];
+            c += 1;
+        }
+        p += 1;
+    }
+    t
+}
+
+/// One `J` row of [`SecondOrderDp::jrow_fast`] in Cortex-M4 assembly (`q_B = 9`,
+/// `rr mod 3 = ROT`), the arithmetic of [`SecondOrderDp::j_cell_sep`]: per column `dx`
+/// of the states, the row maxima `Hx(p_y, dx)` over `ex` (keys `I << 4 + GX`), then the
+/// three states' maxima over `ey` (`+ GY`), `ssat(key >> 4)` stored at the target cells,
+/// the key nibbles summed through [`ATAB`] into the pixel's pointer code (in `codes`).
+/// Registers: `r0` source, `r1` ring cell `3 x`, `r2`-`r7` `GX`, `GY`, `r8`-`r10`
+/// `Hx` then keys, `r11`, `r12` scratch, `lr` the nibbles of states 0, 1, 3, 4, 6, 7.
+#[cfg(target_arch = "arm")]
+#[allow(unsafe_code)]
+#[inline(always)]
+fn j_row_asm<C: MeritCell, const QB: usize, const M: usize, const ROT: usize>(
+    src: &[[C; QB]; M],
+    ring: &mut [[C; QB]],
+    gk: &[i32; 6],
+    codes: &mut [i32; M],
+) {
+    if QB != 9 || ring.len() < 3 * (M + 2) || M == 0 {
+        return;
+    }
+    let sz = core::mem::size_of::<C>();
+    let src_p = src.as_ptr() as usize;
+    // [GX0..2, GY0..2, tables, source end, codes, source, ring]
+    let mut par: [u32; 11] = [
+        gk[0] as u32,
+        gk[1] as u32,
+        gk[2] as u32,
+        gk[3] as u32,
+        gk[4] as u32,
+        gk[5] as u32,
+        ATAB.as_ptr() as u32,
+        (src_p + M * 9 * sz) as u32,
+        codes.as_mut_ptr() as u32,
+        src_p as u32,
+        ring.as_mut_ptr() as u32,
+    ];
+    macro_rules! row {
+        ($ld:literal, $st:literal) => {
+            // SAFETY: the block reads the `M` source cells (`9 M` values) and `ATAB`,
+            // writes `codes[0..M]` and ring cells `0 .. 3 (M + 2)` (state offsets below
+            // `27 sizeof(C)` from cell `3 x`, checked above), and restores r4-r11 and lr.
+            unsafe {
+                core::arch::asm!(
+                    "push {{r4-r11, lr}}",
+                    "push {{{par}}}",
+                    "ldr r0, [{par}, #36]",
+                    "ldr r1, [{par}, #40]",
+                    "ldm {par}, {{r2-r7}}",
+                    "2:",
+                    // column dx = -1: Hx(py) = max(I(py,1) + GX0, I(py,0) + GX1)
+                    concat!($ld, " r8, [r0, #{i1}]"), "add r8, r2, r8, lsl #4",
+                    concat!($ld, " r11, [r0, #{i0}]"), "add r11, r3, r11, lsl #4",
+                    "cmp r8, r11", "it lt", "movlt r8, r11",
+                    concat!($ld, " r9, [r0, #{i4}]"), "add r9, r2, r9, lsl #4",
+                    concat!($ld, " r11, [r0, #{i3}]"), "add r11, r3, r11, lsl #4",
+                    "cmp r9, r11", "it lt", "movlt r9, r11",
+                    concat!($ld, " r10, [r0, #{i7}]"), "add r10, r2, r10, lsl #4",
+                    concat!($ld, " r11, [r0, #{i6}]"), "add r11, r3, r11, lsl #4",
+                    "cmp r10, r11", "it lt", "movlt r10, r11",
+                    // states (dy 0, -1, +1): max over ey
+                    "add r11, r10, r5", "add r12, r9, r6", "cmp r11, r12", "it lt", "movlt r11, r12",
+                    "add r12, r8, r7", "cmp r11, r12", "it lt", "movlt r11, r12",
+                    "ssat r12, #{bits}, r11, asr #4", concat!($st, " r12, [r1, #{o3}]"),
+                    "bfi lr, r11, #8, #4",
+                    "add r8, r8, r6", "add r12, r9, r5", "cmp r8, r12", "it lt", "movlt r8, r12",
+                    "ssat r12, #{bits}, r8, asr #4", concat!($st, " r12, [r1, #{o0}]"),
+                    "bfi lr, r8, #0, #4",
+                    "add r10, r10, r6", "add r9, r9, r7", "cmp r10, r9", "it lt", "movlt r10, r9",
+                    "ssat r12, #{bits}, r10, asr #4", concat!($st, " r12, [r1, #{o6}]"),
+                    "bfi lr, r10, #16, #4",
+                    // column dx = 0: max(I(py,2) + GX0, I(py,1) + GX1, I(py,0) + GX2)
+                    concat!($ld, " r8, [r0, #{i2}]"), "add r8, r2, r8, lsl #4",
+                    concat!($ld, " r11, [r0, #{i1}]"), "add r11, r3, r11, lsl #4",
+                    "cmp r8, r11", "it lt", "movlt r8, r11",
+                    concat!($ld, " r11, [r0, #{i0}]"), "add r11, r4, r11, lsl #4",
+                    "cmp r8, r11", "it lt", "movlt r8, r11",
+                    concat!($ld, " r9, [r0, #{i5}]"), "add r9, r2, r9, lsl #4",
+                    concat!($ld, " r11, [r0, #{i4}]"), "add r11, r3, r11, lsl #4",
+                    "cmp r9, r11", "it lt", "movlt r9, r11",
+                    concat!($ld, " r11, [r0, #{i3}]"), "add r11, r4, r11, lsl #4",
+                    "cmp r9, r11", "it lt", "movlt r9, r11",
+                    concat!($ld, " r10, [r0, #{i8}]"), "add r10, r2, r10, lsl #4",
+                    concat!($ld, " r11, [r0, #{i7}]"), "add r11, r3, r11, lsl #4",
+                    "cmp r10, r11", "it lt", "movlt r10, r11",
+                    concat!($ld, " r11, [r0, #{i6}]"), "add r11, r4, r11, lsl #4",
+                    "cmp r10, r11", "it lt", "movlt r10, r11",
+                    "add r11, r10, r5", "add r12, r9, r6", "cmp r11, r12", "it lt", "movlt r11, r12",
+                    "add r12, r8, r7", "cmp r11, r12", "it lt", "movlt r11, r12",
+                    "ssat r12, #{bits}, r11, asr #4", concat!($st, " r12, [r1, #{o4}]"),
+                    "bfi lr, r11, #12, #4",
+                    "add r8, r8, r6", "add r12, r9, r5", "cmp r8, r12", "it lt", "movlt r8, r12",
+                    "ssat r12, #{bits}, r8, asr #4", concat!($st, " r12, [r1, #{o1}]"),
+                    "bfi lr, r8, #4, #4",
+                    "add r10, r10, r6", "add r9, r9, r7", "cmp r10, r9", "it lt", "movlt r10, r9",
+                    "ssat r12, #{bits}, r10, asr #4", concat!($st, " r12, [r1, #{o7}]"),
+                    "bfi lr, r10, #20, #4",
+                    // column dx = +1: max(I(py,2) + GX1, I(py,1) + GX2)
+                    concat!($ld, " r8, [r0, #{i2}]"), "add r8, r3, r8, lsl #4",
+                    concat!($ld, " r11, [r0, #{i1}]"), "add r11, r4, r11, lsl #4",
+                    "cmp r8, r11", "it lt", "movlt r8, r11",
+                    concat!($ld, " r9, [r0, #{i5}]"), "add r9, r3, r9, lsl #4",
+                    concat!($ld, " r11, [r0, #{i4}]"), "add r11, r4, r11, lsl #4",
+                    "cmp r9, r11", "it lt", "movlt r9, r11",
+                    concat!($ld, " r10, [r0, #{i8}]"), "add r10, r3, r10, lsl #4",
+                    concat!($ld, " r11, [r0, #{i7}]"), "add r11, r4, r11, lsl #4",
+                    "cmp r10, r11", "it lt", "movlt r10, r11",
+                    "add r11, r10, r5", "add r12, r9, r6", "cmp r11, r12", "it lt", "movlt r11, r12",
+                    "add r12, r8, r7", "cmp r11, r12", "it lt", "movlt r11, r12",
+                    "ssat r12, #{bits}, r11, asr #4", concat!($st, " r12, [r1, #{o5}]"),
+                    "add r8, r8, r6", "add r12, r9, r5", "cmp r8, r12", "it lt", "movlt r8, r12",
+                    "ssat r12, #{bits}, r8, asr #4", concat!($st, " r12, [r1, #{o2}]"),
+                    "add r10, r10, r6", "add r9, r9, r7", "cmp r10, r9", "it lt", "movlt r10, r9",
+                    "ssat r12, #{bits}, r10, asr #4", concat!($st, " r12, [r1, #{o8}]"),
+                    // the pointer code: keys of states 8 (r10), 2 (r8), 5 (r11), nibbles in lr
+                    "ldr r12, [sp]",
+                    "ldr r3, [r12, #24]",
+                    "and r4, r10, #15",
+                    "ldr r4, [r3, r4, lsl #2]",
+                    "ubfx r5, lr, #0, #8", "add r5, r3, r5, lsl #2", "ldr r5, [r5, #64]", "add r4, r5",
+                    "ubfx r5, lr, #8, #8", "add r5, r3, r5, lsl #2", "ldr r5, [r5, #1088]", "add r4, r5",
+                    "ubfx r5, lr, #16, #8", "add r5, r3, r5, lsl #2", "ldr r5, [r5, #2112]", "add r4, r5",
+                    "and r5, r8, #15", "bfi r5, r11, #4, #4",
+                    "add r5, r3, r5, lsl #2", "ldr r5, [r5, #3136]", "add r4, r5",
+                    "ldr r5, [r12, #32]",
+                    "str r4, [r5], #4",
+                    "str r5, [r12, #32]",
+                    "add r0, r0, #{csz}",
+                    "add r1, r1, #{rsz}",
+                    "ldr r5, [r12, #28]",
+                    "cmp r0, r5",
+                    "ldm r12, {{r2-r7}}",
+                    "bne 2b",
+                    "add sp, sp, #4",
+                    "pop {{r4-r11, lr}}",
+                    par = in(reg) par.as_mut_ptr(),
+                    i0 = const 0, i1 = const core::mem::size_of::<C>(), i2 = const 2 * core::mem::size_of::<C>(), i3 = const 3 * core::mem::size_of::<C>(),
+                    i4 = const 4 * core::mem::size_of::<C>(), i5 = const 5 * core::mem::size_of::<C>(), i6 = const 6 * core::mem::size_of::<C>(), i7 = const 7 * core::mem::size_of::<C>(),
+                    i8 = const 8 * core::mem::size_of::<C>(),
+                    o0 = const off::<ROT>(0, core::mem::size_of::<C>()), o1 = const off::<ROT>(1, core::mem::size_of::<C>()),
+                    o2 = const off::<ROT>(2, core::mem::size_of::<C>()), o3 = const off::<ROT>(3, core::mem::size_of::<C>()),
+                    o4 = const off::<ROT>(4, core::mem::size_of::<C>()), o5 = const off::<ROT>(5, core::mem::size_of::<C>()),
+                    o6 = const off::<ROT>(6, core::mem::size_of::<C>()), o7 = const off::<ROT>(7, core::mem::size_of::<C>()),
+                    o8 = const off::<ROT>(8, core::mem::size_of::<C>()),
+                    bits = const 8 * core::mem::size_of::<C>(),
+                    csz = const 9 * core::mem::size_of::<C>(),
+                    rsz = const 27 * core::mem::size_of::<C>(),
+                    out("r0") _, out("r1") _, out("r2") _, out("r3") _, out("r12") _, out("lr") _,
+                );
+            }
+        };
+    }
+    if sz == 2 {
+        row!("ldrsh", "strh");
+    } else {
+        row!("ldrsb", "strb");
+    }
+}
+
+/// Byte offset, from ring cell `3 x`, of state `s = 3 (dy + 1) + dx + 1` of source pixel
+/// `x` in row `rr` (`rr mod 3 = ROT`): cell `3 (x + dx + 1) + (rr + dy) mod 3`.
+#[cfg(target_arch = "arm")]
+const fn off<const ROT: usize>(s: usize, sz: usize) -> usize {
+    let (dyi, dxi) = (s / 3, s % 3);
+    ((3 * dxi + (ROT + dyi + 2) % 3) * 9 + s) * sz
+}
+
 /// Keys `[GX(-1..=1), GY(-1..=1)]` of a separable transition term
 /// `g(ex, ey) = gx(ex) + gy(ey)`: `GX = gx << 4 | (ex + 1)`, `GY = gy << 4 | (ey + 1) << 2`
 /// (`gx` the row `ey = 0`, `gy(ey) = g(0, ey) - g(0, 0)`); `None` if `g` is not separable
@@ -459,63 +652,60 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     }
 
     /// `J` of merit row `rr` (`q_B = 9`, separable `g`) written at the target pixels
-    /// `t = t' + d`: `up`, `mid`, `dn` are the padded target rows `rr - 1`, `rr`, `rr + 1`
-    /// (`M + 2` cells, pixel `x` at `x + 1`), so state `d = (dx, dy)` of pixel `x` goes to
-    /// cell `x + 1 + dx` of row `rr + dy`.
-    #[inline(always)]
-    fn j_row_fast(
-        src: &[[C; QB]; M],
-        (up, mid, dn): (&mut [[C; QB]], &mut [[C; QB]], &mut [[C; QB]]),
-        gk: &[i32; 6],
-        mut push: impl FnMut(u32, u32),
-    ) {
-        let gk = *gk;
-        let mut o = [C::ZERO; QB];
-        for (x, cell) in src.iter().enumerate() {
-            Self::j_cell_sep(cell, &gk, &mut o, &mut push);
-            for (dyi, row) in [&mut *up, &mut *mid, &mut *dn].into_iter().enumerate() {
-                if let Some(t) = row.get_mut(x..x + 3) {
-                    for (dxi, tc) in t.iter_mut().enumerate() {
-                        let s = 3 * dyi + dxi;
-                        if let (Some(c), Some(&v)) = (tc.get_mut(s), o.get(s)) {
-                            *c = v;
-                        }
-                    }
-                }
-            }
-        }
-    }
-
-    /// [`Self::j_row_fast`] of merit row `rr` into the ring (see [`Self::run_fast`]).
+    /// `t = t' + d` in the ring of [`Self::run_fast`] (state `d = (dx, dy)` of pixel `x`
+    /// into cell `3 (x + 1 + dx) + (rr + dy) mod 3`); the pixels' pointer codes into
+    /// `codes` ([`ATAB`] sums on the Cortex-M4, [`Self::j_cell_sep`] elsewhere: the same).
     #[inline(always)]
     fn jrow_fast(
         states: &[[[C; QB]; M]; M],
         ring: &mut [[C; QB]],
         rr: usize,
         gk: &[i32; 6],
-        bw: &mut Option<BitWriter<'_>>,
+        codes: &mut [i32; M],
     ) {
-        let rs = M + 2;
         let Some(src) = states.get(rr) else {
             return;
         };
-        let (s0, rest) = ring.split_at_mut(rs.min(ring.len()));
-        let (s1, s2) = rest.split_at_mut(rs.min(rest.len()));
-        let rows = match rr % 3 {
-            0 => (s2, s0, s1),
-            1 => (s0, s1, s2),
-            _ => (s1, s2, s0),
-        };
-        match bw.as_mut() {
-            Some(w) => Self::j_row_fast(src, rows, gk, |c, b| w.push(c, b)),
-            None => Self::j_row_fast(src, rows, gk, |_, _| {}),
+        if ring.len() < 3 * (M + 2) || QB != 9 {
+            return;
+        }
+        #[cfg(target_arch = "arm")]
+        {
+            match rr % 3 {
+                0 => j_row_asm::<C, QB, M, 0>(src, ring, gk, codes),
+                1 => j_row_asm::<C, QB, M, 1>(src, ring, gk, codes),
+                _ => j_row_asm::<C, QB, M, 2>(src, ring, gk, codes),
+            }
+        }
+        #[cfg(not(target_arch = "arm"))]
+        {
+            let gk = *gk;
+            let mut o = [C::ZERO; QB];
+            for (x, (cell, code)) in src.iter().zip(codes.iter_mut()).enumerate() {
+                let mut acc = 0u32;
+                Self::j_cell_sep(cell, &gk, &mut o, &mut |c, _| acc = c);
+                *code = acc as i32;
+                let Some(t) = ring.get_mut(3 * x..3 * x + 9) else {
+                    continue;
+                };
+                for (s, &v) in o.iter().enumerate().take(9) {
+                    let (dyi, dxi) = (s / 3, s % 3);
+                    if let Some(c) = t
+                        .get_mut(3 * dxi + (rr + dyi + 2) % 3)
+                        .and_then(|c| c.get_mut(s))
+                    {
+                        *c = v;
+                    }
+                }
+            }
         }
     }
 
     /// The fast frame (`q_B = 9`, separable `g`, `k >= 3`): `J` at the target pixels in
-    /// three padded ring rows (row `y` in slot `y mod 3`, within `jring`), the new merits
-    /// one contiguous cell per pixel. Sources outside the image stay at the floor (cells
-    /// never written). Returns the best stored merit and its pixel, and the clamp count.
+    /// a ring of three padded rows interleaved per pixel (target row `y`, pixel `x` in
+    /// cell `3 (x + 1) + y mod 3` of `jring`), so the new merits read one contiguous cell
+    /// per pixel. Sources outside the image stay at the floor (cells never written).
+    /// Returns the best stored merit and its pixel, and the clamp count.
     fn run_fast(
         &mut self,
         frame: &[f32],
@@ -525,7 +715,6 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         k: u32,
     ) -> (i32, (u16, u16), u32) {
         let floor = C::sat(C::FLOOR);
-        let rs = M + 2;
         let Self {
             s: states,
             jring,
@@ -543,59 +732,54 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         } else {
             Some(BitWriter::new(words))
         };
+        let bits = Self::LAY.bits;
         let ring = jring.as_flattened_mut();
-        let ring = ring.get_mut(..3 * rs).unwrap_or(&mut []);
-        // the cells no source writes: pixel 0's states dx = +1, pixel M - 1's dx = -1
-        for slot in ring.chunks_exact_mut(rs) {
-            if let Some(a) = slot.get_mut(1) {
-                for i in [2, 5, 8] {
-                    if let Some(c) = a.get_mut(i) {
+        let ring = ring.get_mut(..3 * (M + 2)).unwrap_or(&mut []);
+        let fill = |ring: &mut [[C; QB]], cells: core::ops::Range<usize>, st: [usize; 3]| {
+            for c in ring.iter_mut().take(cells.end).skip(cells.start) {
+                for i in st {
+                    if let Some(c) = c.get_mut(i) {
                         *c = floor;
                     }
                 }
             }
-            if let Some(b) = slot.get_mut(M) {
-                for i in [0, 3, 6] {
-                    if let Some(c) = b.get_mut(i) {
-                        *c = floor;
-                    }
-                }
-            }
-        }
-        // row 0's states dy = +1
-        for c in ring.iter_mut().take(M + 1).skip(1) {
-            for i in [6, 7, 8] {
-                if let Some(c) = c.get_mut(i) {
-                    *c = floor;
-                }
-            }
+        };
+        // the cells no source writes: pixel 0's states dx = +1, pixel M - 1's dx = -1,
+        // row 0's dy = +1
+        fill(ring, 3..6, [2, 5, 8]);
+        fill(ring, 3 * M..3 * M + 3, [0, 3, 6]);
+        for x in 0..M {
+            fill(ring, 3 * x + 3..3 * x + 4, [6, 7, 8]);
         }
         let mut clamped = 0;
         let (mut best, mut bxy) = (i32::MIN, (0u16, 0u16));
-        Self::jrow_fast(states, ring, 0, gk, &mut bw);
+        let push = |bw: &mut Option<BitWriter<'_>>, codes: &[i32; M]| {
+            if let Some(w) = bw.as_mut() {
+                for &c in codes.iter() {
+                    w.push(c as u32, bits);
+                }
+            }
+        };
+        Self::jrow_fast(states, ring, 0, gk, zrow);
+        push(&mut bw, zrow);
         for (y, src) in frame.chunks_exact(M).enumerate() {
             if y + 1 < M {
-                Self::jrow_fast(states, ring, y + 1, gk, &mut bw);
+                Self::jrow_fast(states, ring, y + 1, gk, zrow);
+                push(&mut bw, zrow);
             }
             clamped += quant.row(src, sub, slow, zrow);
-            let Some(slot) = ring.get_mut((y % 3) * rs..(y % 3 + 1) * rs) else {
-                continue;
-            };
+            let sl = y % 3;
             if y + 1 == M {
                 // the last row's states dy = -1
-                for c in slot.iter_mut().take(M + 1).skip(1) {
-                    for i in [0, 1, 2] {
-                        if let Some(c) = c.get_mut(i) {
-                            *c = floor;
-                        }
-                    }
+                for x in 0..M {
+                    fill(ring, 3 * x + 3 + sl..3 * x + 4 + sl, [0, 1, 2]);
                 }
             }
             let Some(row) = states.get_mut(y) else {
                 continue;
             };
             let (mut rb, mut rx) = (i32::MIN, 0usize);
-            let cells = slot.get(1..).unwrap_or(&[]);
+            let cells = ring.get(3 + sl..).unwrap_or(&[]).iter().step_by(3);
             for (x, ((cell, &zq), j)) in row.iter_mut().zip(zrow.iter()).zip(cells).enumerate() {
                 let mut pb = i32::MIN;
                 for (c, jv) in cell.iter_mut().zip(j) {
