@@ -373,6 +373,129 @@ fn j_row_asm<C: MeritCell, const QB: usize, const M: usize, const ROT: usize>(
     }
 }
 
+/// The new merits of one row from the ring in Cortex-M4 assembly (`q_B = 9`), the
+/// arithmetic of [`SecondOrderDp::run_fast`]'s portable loop: `I(x, s) = sat(zq(x) +
+/// J(x, s))` for the `M` pixels (`ring` from row `y`'s cell of pixel 0, every third
+/// cell), two states per register, the row's largest merit kept per halfword
+/// (`ssub16`/`sel`); returns it. `i16`: `qadd16` (exact when every `zq` is an `i16`,
+/// `q16` true; else `None`); `i8`: `sxtb16`, `sadd16`, `ssat16 #8` (always exact).
+#[cfg(target_arch = "arm")]
+#[allow(unsafe_code)]
+#[inline(always)]
+fn scatter_asm<C: MeritCell, const QB: usize, const M: usize>(
+    ring: &[[C; QB]],
+    row: &mut [[C; QB]; M],
+    zrow: &[i32; M],
+    q16: bool,
+) -> Option<i32> {
+    let sz = core::mem::size_of::<C>();
+    if QB != 9 || ring.len() < 3 * M || M == 0 || (sz == 2 && !q16) {
+        return None;
+    }
+    let mut rp = ring.as_ptr();
+    let mut op = row.as_mut_ptr();
+    let mut zp = zrow.as_ptr();
+    let end = zp.wrapping_add(M);
+    let (mut mx, mut m8) = (0x8000_8000u32, 0x8000_8000u32);
+    if sz == 2 {
+        // SAFETY: reads `ring` cells `0, 3, .., 3 (M - 1)` (18 bytes each, checked above)
+        // and `zrow`, writes the `M` cells of `row`; no stack, flags only.
+        unsafe {
+            core::arch::asm!(
+                "2:",
+                "ldr {z}, [{zp}], #4",
+                "pkhbt {z}, {z}, {z}, lsl #16",
+                "ldr {a}, [{rp}], #54",
+                "qadd16 {a}, {a}, {z}",
+                "str {a}, [{op}], #18",
+                "ssub16 {t}, {a}, {mx}",
+                "sel {mx}, {a}, {mx}",
+                ".irp o, 4, 8, 12",
+                "ldr {a}, [{rp}, #(\\o - 54)]",
+                "qadd16 {a}, {a}, {z}",
+                "str {a}, [{op}, #(\\o - 18)]",
+                "ssub16 {t}, {a}, {mx}",
+                "sel {mx}, {a}, {mx}",
+                ".endr",
+                "ldrsh {a}, [{rp}, #-38]",
+                "qadd16 {a}, {a}, {z}",
+                "strh {a}, [{op}, #-2]",
+                "ssub16 {t}, {a}, {m8}",
+                "sel {m8}, {a}, {m8}",
+                "cmp {zp}, {end}",
+                "bne 2b",
+                zp = inout(reg) zp,
+                rp = inout(reg) rp,
+                op = inout(reg) op,
+                mx = inout(reg) mx,
+                m8 = inout(reg) m8,
+                end = in(reg) end,
+                z = out(reg) _,
+                a = out(reg) _,
+                t = out(reg) _,
+                options(nostack),
+            );
+        }
+    } else {
+        // SAFETY: reads `ring` cells `0, 3, .., 3 (M - 1)` (9 bytes each, checked above)
+        // and `zrow`, writes the `M` cells of `row`; no stack, flags only.
+        unsafe {
+            core::arch::asm!(
+                "2:",
+                "ldr {z}, [{zp}], #4",
+                "pkhbt {zz}, {z}, {z}, lsl #16",
+                "ldr {w}, [{rp}], #27",
+                ".irp o, 0, 4",
+                ".if \\o",
+                "ldr {w}, [{rp}, #(\\o - 27)]",
+                ".endif",
+                "sxtb16 {a}, {w}",
+                "sxtb16 {b}, {w}, ror #8",
+                "sadd16 {a}, {a}, {zz}",
+                "sadd16 {b}, {b}, {zz}",
+                "ssat16 {a}, #8, {a}",
+                "ssat16 {b}, #8, {b}",
+                "ssub16 {w}, {a}, {mx}",
+                "sel {mx}, {a}, {mx}",
+                "ssub16 {w}, {b}, {mx}",
+                "sel {mx}, {b}, {mx}",
+                "and {a}, {a}, #0x00FF00FF",
+                "and {b}, {b}, #0x00FF00FF",
+                "orr {a}, {a}, {b}, lsl #8",
+                ".if \\o",
+                "str {a}, [{op}, #(\\o - 9)]",
+                ".else",
+                "str {a}, [{op}], #9",
+                ".endif",
+                ".endr",
+                "ldrsb {a}, [{rp}, #-19]",
+                "add {a}, {a}, {z}",
+                "ssat {a}, #8, {a}",
+                "strb {a}, [{op}, #-1]",
+                "ssub16 {w}, {a}, {m8}",
+                "sel {m8}, {a}, {m8}",
+                "cmp {zp}, {end}",
+                "bne 2b",
+                zp = inout(reg) zp,
+                rp = inout(reg) rp,
+                op = inout(reg) op,
+                mx = inout(reg) mx,
+                m8 = inout(reg) m8,
+                end = in(reg) end,
+                z = out(reg) _,
+                zz = out(reg) _,
+                w = out(reg) _,
+                a = out(reg) _,
+                b = out(reg) _,
+                options(nostack),
+            );
+        }
+    }
+    let _ = (rp, op, zp);
+    let h = |v: u32| i32::from(v as u16 as i16);
+    Some(h(mx).max(h(mx >> 16)).max(h(m8)))
+}
+
 /// Byte offset, from ring cell `3 x`, of state `s = 3 (dy + 1) + dx + 1` of source pixel
 /// `x` in row `rr` (`rr mod 3 = ROT`): cell `3 (x + dx + 1) + (rr + dy) mod 3`.
 #[cfg(target_arch = "arm")]
@@ -753,6 +876,9 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         }
         let mut clamped = 0;
         let (mut best, mut bxy) = (i32::MIN, (0u16, 0u16));
+        // every zq = round(z / lsb) - sub, |round(z / lsb)| <= ZMAX, is an i16
+        #[cfg(target_arch = "arm")]
+        let q16 = sub >= C::ZMAX - 32767 && sub <= 32768 - C::ZMAX;
         let push = |bw: &mut Option<BitWriter<'_>>, codes: &[i32; M]| {
             if let Some(w) = bw.as_mut() {
                 for &c in codes.iter() {
@@ -778,22 +904,39 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             let Some(row) = states.get_mut(y) else {
                 continue;
             };
-            let (mut rb, mut rx) = (i32::MIN, 0usize);
-            let cells = ring.get(3 + sl..).unwrap_or(&[]).iter().step_by(3);
-            for (x, ((cell, &zq), j)) in row.iter_mut().zip(zrow.iter()).zip(cells).enumerate() {
-                let mut pb = i32::MIN;
-                for (c, jv) in cell.iter_mut().zip(j) {
-                    *c = C::sat(zq + jv.get());
-                    let v = c.get();
-                    pb = if v > pb { v } else { pb };
+            let cells = ring.get(3 + sl..).unwrap_or(&[]);
+            #[cfg(target_arch = "arm")]
+            let asm_rb = scatter_asm::<C, QB, M>(cells, row, zrow, q16);
+            #[cfg(not(target_arch = "arm"))]
+            let asm_rb: Option<i32> = None;
+            let (rb, rx) = match asm_rb {
+                // (the pixel only when the frame's best rises: the first holding it)
+                Some(rb) => (rb, None),
+                None => {
+                    let (mut rb, mut rx) = (i32::MIN, 0usize);
+                    let it = row.iter_mut().zip(zrow.iter()).zip(cells.iter().step_by(3));
+                    for (x, ((cell, &zq), j)) in it.enumerate() {
+                        let mut pb = i32::MIN;
+                        for (c, jv) in cell.iter_mut().zip(j) {
+                            *c = C::sat(zq + jv.get());
+                            let v = c.get();
+                            pb = if v > pb { v } else { pb };
+                        }
+                        if pb > rb {
+                            rb = pb;
+                            rx = x;
+                        }
+                    }
+                    (rb, Some(rx))
                 }
-                if pb > rb {
-                    rb = pb;
-                    rx = x;
-                }
-            }
+            };
             if rb > best {
                 best = rb;
+                let rx = rx.unwrap_or_else(|| {
+                    row.iter()
+                        .position(|c| c.iter().any(|v| v.get() == rb))
+                        .unwrap_or(0)
+                });
                 bxy = (rx as u16, y as u16);
             }
         }
