@@ -220,7 +220,9 @@ const fn atab() -> [u32; 16 + 4 * 256] {
 /// `rr mod 3 = ROT`), the arithmetic of [`SecondOrderDp::j_cell_sep`]: per column `dx`
 /// of the states, the row maxima `Hx(p_y, dx)` over `ex` (keys `I << 4 + GX`), then the
 /// three states' maxima over `ey` (`+ GY`), `ssat(key >> 4)` stored at the target cells,
-/// the key nibbles summed through [`ATAB`] into the pixel's pointer code (in `codes`).
+/// the key nibbles summed through [`ATAB`] into the pixel's pointer code, appended to
+/// `bw` as [`BitWriter::push`] does. Returns `false`, having done nothing, if the
+/// writer lacks the words the row completes.
 /// Registers: `r0` source, `r1` ring cell `3 x`, `r2`-`r7` `GX`, `GY`, `r8`-`r10`
 /// `Hx` then keys, `r11`, `r12` scratch, `lr` the nibbles of states 0, 1, 3, 4, 6, 7.
 #[cfg(target_arch = "arm")]
@@ -230,15 +232,20 @@ fn j_row_asm<C: MeritCell, const QB: usize, const M: usize, const ROT: usize>(
     src: &[[C; QB]; M],
     ring: &mut [[C; QB]],
     gk: &[i32; 6],
-    codes: &mut [i32; M],
-) {
-    if QB != 9 || ring.len() < 3 * (M + 2) || M == 0 {
-        return;
+    bw: &mut BitWriter<'_>,
+) -> bool {
+    const BITS: u32 = code_bits(9);
+    let (words, acc, fill) = bw.parts();
+    // (the words this row completes)
+    let need = (*fill as usize + M * BITS as usize) / 32;
+    if QB != 9 || ring.len() < 3 * (M + 2) || M == 0 || words.len() < need || BITS != 22 {
+        return false;
     }
     let sz = core::mem::size_of::<C>();
     let src_p = src.as_ptr() as usize;
-    // [GX0..2, GY0..2, tables, source end, codes, source, ring]
-    let mut par: [u32; 11] = [
+    let w0 = words.as_mut_ptr() as u32;
+    // [GX0..2, GY0..2, tables, source end, (unused), source, ring, word, acc, fill]
+    let mut par: [u32; 14] = [
         gk[0] as u32,
         gk[1] as u32,
         gk[2] as u32,
@@ -247,14 +254,17 @@ fn j_row_asm<C: MeritCell, const QB: usize, const M: usize, const ROT: usize>(
         gk[5] as u32,
         ATAB.as_ptr() as u32,
         (src_p + M * 9 * sz) as u32,
-        codes.as_mut_ptr() as u32,
+        0,
         src_p as u32,
         ring.as_mut_ptr() as u32,
+        w0,
+        *acc,
+        *fill,
     ];
     macro_rules! row {
         ($ld:literal, $st:literal) => {
             // SAFETY: the block reads the `M` source cells (`9 M` values) and `ATAB`,
-            // writes `codes[0..M]` and ring cells `0 .. 3 (M + 2)` (state offsets below
+            // writes the writer's next `need` words and ring cells `0 .. 3 (M + 2)` (state offsets below
             // `27 sizeof(C)` from cell `3 x`, checked above), and restores r4-r11 and lr.
             unsafe {
                 core::arch::asm!(
@@ -338,9 +348,23 @@ fn j_row_asm<C: MeritCell, const QB: usize, const M: usize, const ROT: usize>(
                     "ubfx r5, lr, #16, #8", "add r5, r3, r5, lsl #2", "ldr r5, [r5, #2112]", "add r4, r5",
                     "and r5, r8, #15", "bfi r5, r11, #4, #4",
                     "add r5, r3, r5, lsl #2", "ldr r5, [r5, #3136]", "add r4, r5",
-                    "ldr r5, [r12, #32]",
-                    "str r4, [r5], #4",
-                    "str r5, [r12, #32]",
+                    // append the code's 22 bits to the writer (`BitWriter::push`)
+                    "ldr r5, [r12, #52]",
+                    "ldr r3, [r12, #48]",
+                    "lsl r6, r4, r5",
+                    "orr r3, r3, r6",
+                    "adds r5, r5, #22",
+                    "cmp r5, #32",
+                    "blo 3f",
+                    "ldr r6, [r12, #44]",
+                    "str r3, [r6], #4",
+                    "str r6, [r12, #44]",
+                    "subs r5, r5, #32",
+                    "rsb r6, r5, #22",
+                    "lsr r3, r4, r6",
+                    "3:",
+                    "str r5, [r12, #52]",
+                    "str r3, [r12, #48]",
                     "add r0, r0, #{csz}",
                     "add r1, r1, #{rsz}",
                     "ldr r5, [r12, #28]",
@@ -371,6 +395,11 @@ fn j_row_asm<C: MeritCell, const QB: usize, const M: usize, const ROT: usize>(
     } else {
         row!("ldrsb", "strb");
     }
+    let (w1, a1, f1) = (par[11], par[12], par[13]);
+    *acc = a1;
+    *fill = f1;
+    bw.skip((w1.wrapping_sub(w0) / 4) as usize);
+    true
 }
 
 /// The new merits of one row from the ring in Cortex-M4 assembly (`q_B = 9`), the
@@ -776,8 +805,9 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
 
     /// `J` of merit row `rr` (`q_B = 9`, separable `g`) written at the target pixels
     /// `t = t' + d` in the ring of [`Self::run_fast`] (state `d = (dx, dy)` of pixel `x`
-    /// into cell `3 (x + 1 + dx) + (rr + dy) mod 3`); the pixels' pointer codes into
-    /// `codes` ([`ATAB`] sums on the Cortex-M4, [`Self::j_cell_sep`] elsewhere: the same).
+    /// into cell `3 (x + 1 + dx) + (rr + dy) mod 3`); the pixels' pointer codes appended
+    /// to `bw` (on the Cortex-M4 by [`j_row_asm`], else through `codes` with
+    /// [`Self::j_cell_sep`]: the same).
     #[inline(always)]
     fn jrow_fast(
         states: &[[[C; QB]; M]; M],
@@ -785,6 +815,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         rr: usize,
         gk: &[i32; 6],
         codes: &mut [i32; M],
+        bw: &mut Option<BitWriter<'_>>,
     ) {
         let Some(src) = states.get(rr) else {
             return;
@@ -793,33 +824,38 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             return;
         }
         #[cfg(target_arch = "arm")]
-        {
-            match rr % 3 {
-                0 => j_row_asm::<C, QB, M, 0>(src, ring, gk, codes),
-                1 => j_row_asm::<C, QB, M, 1>(src, ring, gk, codes),
-                _ => j_row_asm::<C, QB, M, 2>(src, ring, gk, codes),
+        if let Some(w) = bw.as_mut() {
+            let done = match rr % 3 {
+                0 => j_row_asm::<C, QB, M, 0>(src, ring, gk, w),
+                1 => j_row_asm::<C, QB, M, 1>(src, ring, gk, w),
+                _ => j_row_asm::<C, QB, M, 2>(src, ring, gk, w),
+            };
+            if done {
+                return;
             }
         }
-        #[cfg(not(target_arch = "arm"))]
-        {
-            let gk = *gk;
-            let mut o = [C::ZERO; QB];
-            for (x, (cell, code)) in src.iter().zip(codes.iter_mut()).enumerate() {
-                let mut acc = 0u32;
-                Self::j_cell_sep(cell, &gk, &mut o, &mut |c, _| acc = c);
-                *code = acc as i32;
-                let Some(t) = ring.get_mut(3 * x..3 * x + 9) else {
-                    continue;
-                };
-                for (s, &v) in o.iter().enumerate().take(9) {
-                    let (dyi, dxi) = (s / 3, s % 3);
-                    if let Some(c) = t
-                        .get_mut(3 * dxi + (rr + dyi + 2) % 3)
-                        .and_then(|c| c.get_mut(s))
-                    {
-                        *c = v;
-                    }
+        let gk = *gk;
+        let mut o = [C::ZERO; QB];
+        for (x, (cell, code)) in src.iter().zip(codes.iter_mut()).enumerate() {
+            let mut acc = 0u32;
+            Self::j_cell_sep(cell, &gk, &mut o, &mut |c, _| acc = c);
+            *code = acc as i32;
+            let Some(t) = ring.get_mut(3 * x..3 * x + 9) else {
+                continue;
+            };
+            for (s, &v) in o.iter().enumerate().take(9) {
+                let (dyi, dxi) = (s / 3, s % 3);
+                if let Some(c) = t
+                    .get_mut(3 * dxi + (rr + dyi + 2) % 3)
+                    .and_then(|c| c.get_mut(s))
+                {
+                    *c = v;
                 }
+            }
+        }
+        if let Some(w) = bw.as_mut() {
+            for &c in codes.iter() {
+                w.push(c as u32, Self::LAY.bits);
             }
         }
     }
@@ -855,7 +891,6 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         } else {
             Some(BitWriter::new(words))
         };
-        let bits = Self::LAY.bits;
         let ring = jring.as_flattened_mut();
         let ring = ring.get_mut(..3 * (M + 2)).unwrap_or(&mut []);
         let fill = |ring: &mut [[C; QB]], cells: core::ops::Range<usize>, st: [usize; 3]| {
@@ -879,19 +914,10 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         // every zq = round(z / lsb) - sub, |round(z / lsb)| <= ZMAX, is an i16
         #[cfg(target_arch = "arm")]
         let q16 = sub >= C::ZMAX - 32767 && sub <= 32768 - C::ZMAX;
-        let push = |bw: &mut Option<BitWriter<'_>>, codes: &[i32; M]| {
-            if let Some(w) = bw.as_mut() {
-                for &c in codes.iter() {
-                    w.push(c as u32, bits);
-                }
-            }
-        };
-        Self::jrow_fast(states, ring, 0, gk, zrow);
-        push(&mut bw, zrow);
+        Self::jrow_fast(states, ring, 0, gk, zrow, &mut bw);
         for (y, src) in frame.chunks_exact(M).enumerate() {
             if y + 1 < M {
-                Self::jrow_fast(states, ring, y + 1, gk, zrow);
-                push(&mut bw, zrow);
+                Self::jrow_fast(states, ring, y + 1, gk, zrow, &mut bw);
             }
             clamped += quant.row(src, sub, slow, zrow);
             let sl = y % 3;
