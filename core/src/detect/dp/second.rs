@@ -407,7 +407,8 @@ fn j_row_asm<C: MeritCell, const QB: usize, const M: usize, const ROT: usize>(
 /// J(x, s))` for the `M` pixels (`ring` from row `y`'s cell of pixel 0, every third
 /// cell), two states per register, the row's largest merit kept per halfword
 /// (`ssub16`/`sel`); returns it. `i16`: `qadd16` (exact when every `zq` is an `i16`,
-/// `q16` true; else `None`); `i8`: `sxtb16`, `sadd16`, `ssat16 #8` (always exact).
+/// `q16` true; else `None`); `i8`: `qadd8`, four states per register, when every `zq`
+/// is an `i8` (`q16` true), else `sxtb16`, `sadd16`, `ssat16 #8` (always exact).
 #[cfg(target_arch = "arm")]
 #[allow(unsafe_code)]
 #[inline(always)]
@@ -425,7 +426,11 @@ fn scatter_asm<C: MeritCell, const QB: usize, const M: usize>(
     let mut op = row.as_mut_ptr();
     let mut zp = zrow.as_ptr();
     let end = zp.wrapping_add(M);
-    let (mut mx, mut m8) = (0x8000_8000u32, 0x8000_8000u32);
+    let (mut mx, mut m8) = if sz == 1 && q16 {
+        (0x8080_8080u32, 0x8080_8080u32)
+    } else {
+        (0x8000_8000u32, 0x8000_8000u32)
+    };
     if sz == 2 {
         // SAFETY: reads `ring` cells `0, 3, .., 3 (M - 1)` (18 bytes each, checked above)
         // and `zrow`, writes the `M` cells of `row`; no stack, flags only.
@@ -465,6 +470,54 @@ fn scatter_asm<C: MeritCell, const QB: usize, const M: usize>(
                 options(nostack),
             );
         }
+    } else if q16 {
+        // SAFETY: reads `ring` cells `0, 3, .., 3 (M - 1)` (9 bytes each, checked above)
+        // and `zrow`, writes the `M` cells of `row`; no stack, flags only.
+        unsafe {
+            core::arch::asm!(
+                "2:",
+                "ldr {z}, [{zp}], #4",
+                "uxtb {z}, {z}",
+                "orr {z}, {z}, {z}, lsl #8",
+                "orr {z}, {z}, {z}, lsl #16",
+                "ldr {a}, [{rp}], #27",
+                "qadd8 {a}, {a}, {z}",
+                "str {a}, [{op}], #9",
+                "ssub8 {t}, {a}, {mx}",
+                "sel {mx}, {a}, {mx}",
+                "ldr {a}, [{rp}, #-23]",
+                "qadd8 {a}, {a}, {z}",
+                "str {a}, [{op}, #-5]",
+                "ssub8 {t}, {a}, {mx}",
+                "sel {mx}, {a}, {mx}",
+                "ldrb {a}, [{rp}, #-19]",
+                "qadd8 {a}, {a}, {z}",
+                "strb {a}, [{op}, #-1]",
+                "ssub8 {t}, {a}, {m8}",
+                "sel {m8}, {a}, {m8}",
+                "cmp {zp}, {end}",
+                "bne 2b",
+                zp = inout(reg) zp,
+                rp = inout(reg) rp,
+                op = inout(reg) op,
+                mx = inout(reg) mx,
+                m8 = inout(reg) m8,
+                end = in(reg) end,
+                z = out(reg) _,
+                a = out(reg) _,
+                t = out(reg) _,
+                options(nostack),
+            );
+        }
+        let _ = (rp, op, zp);
+        let b = |v: u32| i32::from(v as u8 as i8);
+        return Some(
+            b(mx)
+                .max(b(mx >> 8))
+                .max(b(mx >> 16))
+                .max(b(mx >> 24))
+                .max(b(m8)),
+        );
     } else {
         // SAFETY: reads `ring` cells `0, 3, .., 3 (M - 1)` (9 bytes each, checked above)
         // and `zrow`, writes the `M` cells of `row`; no stack, flags only.
@@ -911,9 +964,12 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         }
         let mut clamped = 0;
         let (mut best, mut bxy) = (i32::MIN, (0u16, 0u16));
-        // every zq = round(z / lsb) - sub, |round(z / lsb)| <= ZMAX, is an i16
+        // every zq = round(z / lsb) - sub, |round(z / lsb)| <= ZMAX, is a cell value
         #[cfg(target_arch = "arm")]
-        let q16 = sub >= C::ZMAX - 32767 && sub <= 32768 - C::ZMAX;
+        let q16 = {
+            let cmax = C::sat(i32::MAX).get();
+            sub >= C::ZMAX - cmax && sub <= cmax + 1 - C::ZMAX
+        };
         Self::jrow_fast(states, ring, 0, gk, zrow, &mut bw);
         for (y, src) in frame.chunks_exact(M).enumerate() {
             if y + 1 < M {
