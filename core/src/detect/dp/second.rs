@@ -28,6 +28,11 @@
 //! `(ey + 1) << 2 | (ex + 1)`, which ascends with `j`: the same winners and pointers, 24
 //! compare-selects per pixel instead of 40. Otherwise the candidates are compared directly.
 //!
+//! For `q_B = 9` with a separable `g`, from frame 3, `J` is written directly at the target
+//! pixels, in three padded target rows held in the `J` rows' memory, and the new merits
+//! read one contiguous cell per pixel (`run_fast`); on the Cortex-M4 both passes are
+//! `asm!` rows whose portable twins give the same merits and pointers.
+//!
 //! Memory ([`second_order_bytes`](super::second_order_bytes)): `M^2 q_B sizeof(C)`
 //! merits, `5 M q_B sizeof(C)` bytes of `J` rows, `4 M` of a row buffer, 64 of transition
 //! keys, `4 W = (L - 2) ceil(M^2 b / 32) 4` bytes of back-pointers and 144 of fixed
