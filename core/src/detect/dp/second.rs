@@ -28,6 +28,11 @@
 //! `(ey + 1) << 2 | (ex + 1)`, which ascends with `j`: the same winners and pointers, 24
 //! compare-selects per pixel instead of 40. Otherwise the candidates are compared directly.
 //!
+//! For `q_B = 9` with a separable `g`, from frame 3, `J` is written directly at the target
+//! pixels, in three padded target rows held in the `J` rows' memory, and the new merits
+//! read one contiguous cell per pixel (`run_fast`); on the Cortex-M4 both passes are
+//! `asm!` rows whose portable twins give the same merits and pointers.
+//!
 //! Memory ([`second_order_bytes`](super::second_order_bytes)): `M^2 q_B sizeof(C)`
 //! merits, `5 M q_B sizeof(C)` bytes of `J` rows, `4 M` of a row buffer, 64 of transition
 //! keys, `4 W = (L - 2) ceil(M^2 b / 32) 4` bytes of back-pointers and 144 of fixed
@@ -186,6 +191,404 @@ pub(crate) const fn layout(qb: usize) -> Layout {
         i += 1;
     }
     l
+}
+
+/// Pointer-code tables of the Cortex-M4 `J` row ([`j_row_asm`], `q_B = 9`): the code is
+/// the sum of `jterm[d][c_d]` over the states, looked up as `jterm[8]` (16 words) and the
+/// pairs `(0, 1)`, `(3, 4)`, `(6, 7)`, `(2, 5)` (256 words each, index `c_a | c_b << 4`).
+#[cfg_attr(not(target_arch = "arm"), allow(dead_code))]
+static ATAB: [u32; 16 + 4 * 256] = atab();
+
+const fn atab() -> [u32; 16 + 4 * 256] {
+    let l = layout(9);
+    let mut t = [0u32; 16 + 4 * 256];
+    let mut c = 0;
+    while c < 16 {
+        t[c] = l.jterm[8][c];
+        c += 1;
+    }
+    let pairs = [(0, 1), (3, 4), (6, 7), (2, 5)];
+    let mut p = 0;
+    while p < 4 {
+        let (a, b) = pairs[p];
+        let mut c = 0;
+        while c < 256 {
+            t[16 + 256 * p + c] = l.jterm[a][c & 15] + l.jterm[b][c >> 4];
+            c += 1;
+        }
+        p += 1;
+    }
+    t
+}
+
+/// One `J` row of [`SecondOrderDp::jrow_fast`] in Cortex-M4 assembly (`q_B = 9`,
+/// `rr mod 3 = ROT`), the arithmetic of [`SecondOrderDp::j_cell_sep`]: per column `dx`
+/// of the states, the row maxima `Hx(p_y, dx)` over `ex` (keys `I << 4 + GX`), then the
+/// three states' maxima over `ey` (`+ GY`), `ssat(key >> 4)` stored at the target cells,
+/// the key nibbles summed through [`ATAB`] into the pixel's pointer code, appended to
+/// `bw` as [`BitWriter::push`] does. Returns `false`, having done nothing, if the
+/// writer lacks the words the row completes.
+/// Registers: `r0` source, `r1` ring cell `3 x`, `r2`-`r7` `GX`, `GY`, `r8`-`r10`
+/// `Hx` then keys, `r11`, `r12` scratch, `lr` the nibbles of states 0, 1, 3, 4, 6, 7.
+#[cfg(target_arch = "arm")]
+#[allow(unsafe_code)]
+#[inline(always)]
+fn j_row_asm<C: MeritCell, const QB: usize, const M: usize, const ROT: usize>(
+    src: &[[C; QB]; M],
+    ring: &mut [[C; QB]],
+    gk: &[i32; 6],
+    bw: &mut BitWriter<'_>,
+) -> bool {
+    const BITS: u32 = code_bits(9);
+    let (words, acc, fill) = bw.parts();
+    // (the words this row completes)
+    let need = (*fill as usize + M * BITS as usize) / 32;
+    if QB != 9 || ring.len() < 3 * (M + 2) || M == 0 || words.len() < need || BITS != 22 {
+        return false;
+    }
+    let sz = core::mem::size_of::<C>();
+    let src_p = src.as_ptr() as usize;
+    let w0 = words.as_mut_ptr() as u32;
+    // [GX0..2, GY0..2, tables, source end, (unused), source, ring, word, acc, fill]
+    let mut par: [u32; 14] = [
+        gk[0] as u32,
+        gk[1] as u32,
+        gk[2] as u32,
+        gk[3] as u32,
+        gk[4] as u32,
+        gk[5] as u32,
+        ATAB.as_ptr() as u32,
+        (src_p + M * 9 * sz) as u32,
+        0,
+        src_p as u32,
+        ring.as_mut_ptr() as u32,
+        w0,
+        *acc,
+        *fill,
+    ];
+    macro_rules! row {
+        ($ld:literal, $st:literal) => {
+            // SAFETY: the block reads the `M` source cells (`9 M` values) and `ATAB`,
+            // writes the writer's next `need` words and ring cells `0 .. 3 (M + 2)` (state offsets below
+            // `27 sizeof(C)` from cell `3 x`, checked above), and restores r4-r11 and lr.
+            unsafe {
+                core::arch::asm!(
+                    "push {{r4-r11, lr}}",
+                    "push {{{par}}}",
+                    "ldr r0, [{par}, #36]",
+                    "ldr r1, [{par}, #40]",
+                    "ldm {par}, {{r2-r7}}",
+                    "2:",
+                    // column dx = -1: Hx(py) = max(I(py,1) + GX0, I(py,0) + GX1)
+                    concat!($ld, " r8, [r0, #{i1}]"), "add r8, r2, r8, lsl #4",
+                    concat!($ld, " r11, [r0, #{i0}]"), "add r11, r3, r11, lsl #4",
+                    "cmp r8, r11", "it lt", "movlt r8, r11",
+                    concat!($ld, " r9, [r0, #{i4}]"), "add r9, r2, r9, lsl #4",
+                    concat!($ld, " r11, [r0, #{i3}]"), "add r11, r3, r11, lsl #4",
+                    "cmp r9, r11", "it lt", "movlt r9, r11",
+                    concat!($ld, " r10, [r0, #{i7}]"), "add r10, r2, r10, lsl #4",
+                    concat!($ld, " r11, [r0, #{i6}]"), "add r11, r3, r11, lsl #4",
+                    "cmp r10, r11", "it lt", "movlt r10, r11",
+                    // states (dy 0, -1, +1): max over ey
+                    "add r11, r10, r5", "add r12, r9, r6", "cmp r11, r12", "it lt", "movlt r11, r12",
+                    "add r12, r8, r7", "cmp r11, r12", "it lt", "movlt r11, r12",
+                    "ssat r12, #{bits}, r11, asr #4", concat!($st, " r12, [r1, #{o3}]"),
+                    "bfi lr, r11, #8, #4",
+                    "add r8, r8, r6", "add r12, r9, r5", "cmp r8, r12", "it lt", "movlt r8, r12",
+                    "ssat r12, #{bits}, r8, asr #4", concat!($st, " r12, [r1, #{o0}]"),
+                    "bfi lr, r8, #0, #4",
+                    "add r10, r10, r6", "add r9, r9, r7", "cmp r10, r9", "it lt", "movlt r10, r9",
+                    "ssat r12, #{bits}, r10, asr #4", concat!($st, " r12, [r1, #{o6}]"),
+                    "bfi lr, r10, #16, #4",
+                    // column dx = 0: max(I(py,2) + GX0, I(py,1) + GX1, I(py,0) + GX2)
+                    concat!($ld, " r8, [r0, #{i2}]"), "add r8, r2, r8, lsl #4",
+                    concat!($ld, " r11, [r0, #{i1}]"), "add r11, r3, r11, lsl #4",
+                    "cmp r8, r11", "it lt", "movlt r8, r11",
+                    concat!($ld, " r11, [r0, #{i0}]"), "add r11, r4, r11, lsl #4",
+                    "cmp r8, r11", "it lt", "movlt r8, r11",
+                    concat!($ld, " r9, [r0, #{i5}]"), "add r9, r2, r9, lsl #4",
+                    concat!($ld, " r11, [r0, #{i4}]"), "add r11, r3, r11, lsl #4",
+                    "cmp r9, r11", "it lt", "movlt r9, r11",
+                    concat!($ld, " r11, [r0, #{i3}]"), "add r11, r4, r11, lsl #4",
+                    "cmp r9, r11", "it lt", "movlt r9, r11",
+                    concat!($ld, " r10, [r0, #{i8}]"), "add r10, r2, r10, lsl #4",
+                    concat!($ld, " r11, [r0, #{i7}]"), "add r11, r3, r11, lsl #4",
+                    "cmp r10, r11", "it lt", "movlt r10, r11",
+                    concat!($ld, " r11, [r0, #{i6}]"), "add r11, r4, r11, lsl #4",
+                    "cmp r10, r11", "it lt", "movlt r10, r11",
+                    "add r11, r10, r5", "add r12, r9, r6", "cmp r11, r12", "it lt", "movlt r11, r12",
+                    "add r12, r8, r7", "cmp r11, r12", "it lt", "movlt r11, r12",
+                    "ssat r12, #{bits}, r11, asr #4", concat!($st, " r12, [r1, #{o4}]"),
+                    "bfi lr, r11, #12, #4",
+                    "add r8, r8, r6", "add r12, r9, r5", "cmp r8, r12", "it lt", "movlt r8, r12",
+                    "ssat r12, #{bits}, r8, asr #4", concat!($st, " r12, [r1, #{o1}]"),
+                    "bfi lr, r8, #4, #4",
+                    "add r10, r10, r6", "add r9, r9, r7", "cmp r10, r9", "it lt", "movlt r10, r9",
+                    "ssat r12, #{bits}, r10, asr #4", concat!($st, " r12, [r1, #{o7}]"),
+                    "bfi lr, r10, #20, #4",
+                    // column dx = +1: max(I(py,2) + GX1, I(py,1) + GX2)
+                    concat!($ld, " r8, [r0, #{i2}]"), "add r8, r3, r8, lsl #4",
+                    concat!($ld, " r11, [r0, #{i1}]"), "add r11, r4, r11, lsl #4",
+                    "cmp r8, r11", "it lt", "movlt r8, r11",
+                    concat!($ld, " r9, [r0, #{i5}]"), "add r9, r3, r9, lsl #4",
+                    concat!($ld, " r11, [r0, #{i4}]"), "add r11, r4, r11, lsl #4",
+                    "cmp r9, r11", "it lt", "movlt r9, r11",
+                    concat!($ld, " r10, [r0, #{i8}]"), "add r10, r3, r10, lsl #4",
+                    concat!($ld, " r11, [r0, #{i7}]"), "add r11, r4, r11, lsl #4",
+                    "cmp r10, r11", "it lt", "movlt r10, r11",
+                    "add r11, r10, r5", "add r12, r9, r6", "cmp r11, r12", "it lt", "movlt r11, r12",
+                    "add r12, r8, r7", "cmp r11, r12", "it lt", "movlt r11, r12",
+                    "ssat r12, #{bits}, r11, asr #4", concat!($st, " r12, [r1, #{o5}]"),
+                    "add r8, r8, r6", "add r12, r9, r5", "cmp r8, r12", "it lt", "movlt r8, r12",
+                    "ssat r12, #{bits}, r8, asr #4", concat!($st, " r12, [r1, #{o2}]"),
+                    "add r10, r10, r6", "add r9, r9, r7", "cmp r10, r9", "it lt", "movlt r10, r9",
+                    "ssat r12, #{bits}, r10, asr #4", concat!($st, " r12, [r1, #{o8}]"),
+                    // the pointer code: keys of states 8 (r10), 2 (r8), 5 (r11), nibbles in lr
+                    "ldr r12, [sp]",
+                    "ldr r3, [r12, #24]",
+                    "and r4, r10, #15",
+                    "ldr r4, [r3, r4, lsl #2]",
+                    "ubfx r5, lr, #0, #8", "add r5, r3, r5, lsl #2", "ldr r5, [r5, #64]", "add r4, r5",
+                    "ubfx r5, lr, #8, #8", "add r5, r3, r5, lsl #2", "ldr r5, [r5, #1088]", "add r4, r5",
+                    "ubfx r5, lr, #16, #8", "add r5, r3, r5, lsl #2", "ldr r5, [r5, #2112]", "add r4, r5",
+                    "and r5, r8, #15", "bfi r5, r11, #4, #4",
+                    "add r5, r3, r5, lsl #2", "ldr r5, [r5, #3136]", "add r4, r5",
+                    // append the code's 22 bits to the writer (`BitWriter::push`)
+                    "ldr r5, [r12, #52]",
+                    "ldr r3, [r12, #48]",
+                    "lsl r6, r4, r5",
+                    "orr r3, r3, r6",
+                    "adds r5, r5, #22",
+                    "cmp r5, #32",
+                    "blo 3f",
+                    "ldr r6, [r12, #44]",
+                    "str r3, [r6], #4",
+                    "str r6, [r12, #44]",
+                    "subs r5, r5, #32",
+                    "rsb r6, r5, #22",
+                    "lsr r3, r4, r6",
+                    "3:",
+                    "str r5, [r12, #52]",
+                    "str r3, [r12, #48]",
+                    "add r0, r0, #{csz}",
+                    "add r1, r1, #{rsz}",
+                    "ldr r5, [r12, #28]",
+                    "cmp r0, r5",
+                    "ldm r12, {{r2-r7}}",
+                    "bne 2b",
+                    "add sp, sp, #4",
+                    "pop {{r4-r11, lr}}",
+                    par = in(reg) par.as_mut_ptr(),
+                    i0 = const 0, i1 = const core::mem::size_of::<C>(), i2 = const 2 * core::mem::size_of::<C>(), i3 = const 3 * core::mem::size_of::<C>(),
+                    i4 = const 4 * core::mem::size_of::<C>(), i5 = const 5 * core::mem::size_of::<C>(), i6 = const 6 * core::mem::size_of::<C>(), i7 = const 7 * core::mem::size_of::<C>(),
+                    i8 = const 8 * core::mem::size_of::<C>(),
+                    o0 = const off::<ROT>(0, core::mem::size_of::<C>()), o1 = const off::<ROT>(1, core::mem::size_of::<C>()),
+                    o2 = const off::<ROT>(2, core::mem::size_of::<C>()), o3 = const off::<ROT>(3, core::mem::size_of::<C>()),
+                    o4 = const off::<ROT>(4, core::mem::size_of::<C>()), o5 = const off::<ROT>(5, core::mem::size_of::<C>()),
+                    o6 = const off::<ROT>(6, core::mem::size_of::<C>()), o7 = const off::<ROT>(7, core::mem::size_of::<C>()),
+                    o8 = const off::<ROT>(8, core::mem::size_of::<C>()),
+                    bits = const 8 * core::mem::size_of::<C>(),
+                    csz = const 9 * core::mem::size_of::<C>(),
+                    rsz = const 27 * core::mem::size_of::<C>(),
+                    out("r0") _, out("r1") _, out("r2") _, out("r3") _, out("r12") _, out("lr") _,
+                );
+            }
+        };
+    }
+    if sz == 2 {
+        row!("ldrsh", "strh");
+    } else {
+        row!("ldrsb", "strb");
+    }
+    let (w1, a1, f1) = (par[11], par[12], par[13]);
+    *acc = a1;
+    *fill = f1;
+    bw.skip((w1.wrapping_sub(w0) / 4) as usize);
+    true
+}
+
+/// The new merits of one row from the ring in Cortex-M4 assembly (`q_B = 9`), the
+/// arithmetic of [`SecondOrderDp::run_fast`]'s portable loop: `I(x, s) = sat(zq(x) +
+/// J(x, s))` for the `M` pixels (`ring` from row `y`'s cell of pixel 0, every third
+/// cell), two states per register, the row's largest merit kept per halfword
+/// (`ssub16`/`sel`); returns it. `i16`: `qadd16` (exact when every `zq` is an `i16`,
+/// `q16` true; else `None`); `i8`: `qadd8`, four states per register, when every `zq`
+/// is an `i8` (`q16` true), else `sxtb16`, `sadd16`, `ssat16 #8` (always exact).
+#[cfg(target_arch = "arm")]
+#[allow(unsafe_code)]
+#[inline(always)]
+fn scatter_asm<C: MeritCell, const QB: usize, const M: usize>(
+    ring: &[[C; QB]],
+    row: &mut [[C; QB]; M],
+    zrow: &[i32; M],
+    q16: bool,
+) -> Option<i32> {
+    let sz = core::mem::size_of::<C>();
+    if QB != 9 || ring.len() < 3 * M || M == 0 || (sz == 2 && !q16) {
+        return None;
+    }
+    let mut rp = ring.as_ptr();
+    let mut op = row.as_mut_ptr();
+    let mut zp = zrow.as_ptr();
+    let end = zp.wrapping_add(M);
+    let (mut mx, mut m8) = if sz == 1 && q16 {
+        (0x8080_8080u32, 0x8080_8080u32)
+    } else {
+        (0x8000_8000u32, 0x8000_8000u32)
+    };
+    if sz == 2 {
+        // SAFETY: reads `ring` cells `0, 3, .., 3 (M - 1)` (18 bytes each, checked above)
+        // and `zrow`, writes the `M` cells of `row`; no stack, flags only.
+        unsafe {
+            core::arch::asm!(
+                "2:",
+                "ldr {z}, [{zp}], #4",
+                "pkhbt {z}, {z}, {z}, lsl #16",
+                "ldr {a}, [{rp}], #54",
+                "qadd16 {a}, {a}, {z}",
+                "str {a}, [{op}], #18",
+                "ssub16 {t}, {a}, {mx}",
+                "sel {mx}, {a}, {mx}",
+                ".irp o, 4, 8, 12",
+                "ldr {a}, [{rp}, #(\\o - 54)]",
+                "qadd16 {a}, {a}, {z}",
+                "str {a}, [{op}, #(\\o - 18)]",
+                "ssub16 {t}, {a}, {mx}",
+                "sel {mx}, {a}, {mx}",
+                ".endr",
+                "ldrsh {a}, [{rp}, #-38]",
+                "qadd16 {a}, {a}, {z}",
+                "strh {a}, [{op}, #-2]",
+                "ssub16 {t}, {a}, {m8}",
+                "sel {m8}, {a}, {m8}",
+                "cmp {zp}, {end}",
+                "bne 2b",
+                zp = inout(reg) zp,
+                rp = inout(reg) rp,
+                op = inout(reg) op,
+                mx = inout(reg) mx,
+                m8 = inout(reg) m8,
+                end = in(reg) end,
+                z = out(reg) _,
+                a = out(reg) _,
+                t = out(reg) _,
+                options(nostack),
+            );
+        }
+    } else if q16 {
+        // SAFETY: reads `ring` cells `0, 3, .., 3 (M - 1)` (9 bytes each, checked above)
+        // and `zrow`, writes the `M` cells of `row`; no stack, flags only.
+        unsafe {
+            core::arch::asm!(
+                "2:",
+                "ldr {z}, [{zp}], #4",
+                "uxtb {z}, {z}",
+                "orr {z}, {z}, {z}, lsl #8",
+                "orr {z}, {z}, {z}, lsl #16",
+                "ldr {a}, [{rp}], #27",
+                "qadd8 {a}, {a}, {z}",
+                "str {a}, [{op}], #9",
+                "ssub8 {t}, {a}, {mx}",
+                "sel {mx}, {a}, {mx}",
+                "ldr {a}, [{rp}, #-23]",
+                "qadd8 {a}, {a}, {z}",
+                "str {a}, [{op}, #-5]",
+                "ssub8 {t}, {a}, {mx}",
+                "sel {mx}, {a}, {mx}",
+                "ldrb {a}, [{rp}, #-19]",
+                "qadd8 {a}, {a}, {z}",
+                "strb {a}, [{op}, #-1]",
+                "ssub8 {t}, {a}, {m8}",
+                "sel {m8}, {a}, {m8}",
+                "cmp {zp}, {end}",
+                "bne 2b",
+                zp = inout(reg) zp,
+                rp = inout(reg) rp,
+                op = inout(reg) op,
+                mx = inout(reg) mx,
+                m8 = inout(reg) m8,
+                end = in(reg) end,
+                z = out(reg) _,
+                a = out(reg) _,
+                t = out(reg) _,
+                options(nostack),
+            );
+        }
+        let _ = (rp, op, zp);
+        let b = |v: u32| i32::from(v as u8 as i8);
+        return Some(
+            b(mx)
+                .max(b(mx >> 8))
+                .max(b(mx >> 16))
+                .max(b(mx >> 24))
+                .max(b(m8)),
+        );
+    } else {
+        // SAFETY: reads `ring` cells `0, 3, .., 3 (M - 1)` (9 bytes each, checked above)
+        // and `zrow`, writes the `M` cells of `row`; no stack, flags only.
+        unsafe {
+            core::arch::asm!(
+                "2:",
+                "ldr {z}, [{zp}], #4",
+                "pkhbt {zz}, {z}, {z}, lsl #16",
+                "ldr {w}, [{rp}], #27",
+                ".irp o, 0, 4",
+                ".if \\o",
+                "ldr {w}, [{rp}, #(\\o - 27)]",
+                ".endif",
+                "sxtb16 {a}, {w}",
+                "sxtb16 {b}, {w}, ror #8",
+                "sadd16 {a}, {a}, {zz}",
+                "sadd16 {b}, {b}, {zz}",
+                "ssat16 {a}, #8, {a}",
+                "ssat16 {b}, #8, {b}",
+                "ssub16 {w}, {a}, {mx}",
+                "sel {mx}, {a}, {mx}",
+                "ssub16 {w}, {b}, {mx}",
+                "sel {mx}, {b}, {mx}",
+                "and {a}, {a}, #0x00FF00FF",
+                "and {b}, {b}, #0x00FF00FF",
+                "orr {a}, {a}, {b}, lsl #8",
+                ".if \\o",
+                "str {a}, [{op}, #(\\o - 9)]",
+                ".else",
+                "str {a}, [{op}], #9",
+                ".endif",
+                ".endr",
+                "ldrsb {a}, [{rp}, #-19]",
+                "add {a}, {a}, {z}",
+                "ssat {a}, #8, {a}",
+                "strb {a}, [{op}, #-1]",
+                "ssub16 {w}, {a}, {m8}",
+                "sel {m8}, {a}, {m8}",
+                "cmp {zp}, {end}",
+                "bne 2b",
+                zp = inout(reg) zp,
+                rp = inout(reg) rp,
+                op = inout(reg) op,
+                mx = inout(reg) mx,
+                m8 = inout(reg) m8,
+                end = in(reg) end,
+                z = out(reg) _,
+                zz = out(reg) _,
+                w = out(reg) _,
+                a = out(reg) _,
+                b = out(reg) _,
+                options(nostack),
+            );
+        }
+    }
+    let _ = (rp, op, zp);
+    let h = |v: u32| i32::from(v as u16 as i16);
+    Some(h(mx).max(h(mx >> 16)).max(h(m8)))
+}
+
+/// Byte offset, from ring cell `3 x`, of state `s = 3 (dy + 1) + dx + 1` of source pixel
+/// `x` in row `rr` (`rr mod 3 = ROT`): cell `3 (x + dx + 1) + (rr + dy) mod 3`.
+#[cfg(target_arch = "arm")]
+const fn off<const ROT: usize>(s: usize, sz: usize) -> usize {
+    let (dyi, dxi) = (s / 3, s % 3);
+    ((3 * dxi + (ROT + dyi + 2) % 3) * 9 + s) * sz
 }
 
 /// Keys `[GX(-1..=1), GY(-1..=1)]` of a separable transition term
@@ -376,10 +779,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         }
     }
 
-    /// `J` of one row when `g` is separable: `J(d) = max_ey [GY(ey) + Hx(d - (0, ey), dx)]`,
-    /// `Hx(p_y, dx) = max_ex [I(p) << 4 + GX(ex)]` (row maxima shared by the states). The
-    /// keys carry `(ey + 1) << 2 | (ex + 1)`, ordered like the candidate index `j` (both
-    /// ascend in `e`), so the winner and its pointer are those of the plain 2-D max.
+    /// `J` of one row when `g` is separable ([`Self::j_cell_sep`] per pixel).
     #[inline(always)]
     fn j_row_sep(
         src: &[[C; QB]; M],
@@ -387,64 +787,250 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         gk: &[i32; 6],
         mut push: impl FnMut(u32, u32),
     ) {
-        let lay = &Self::LAY;
-        let n = Self::N;
         let gk = *gk;
         for (cell, out) in src.iter().zip(dst.iter_mut()) {
-            // hx[p_y][dx] over ex with p_x = dx - ex inside the window
-            let mut hx = [[FLOOR_KEY; 5]; 5];
-            for (pyi, hrow) in hx.iter_mut().enumerate().take(n) {
-                for (dxi, h) in hrow.iter_mut().enumerate().take(n) {
-                    // (`first`: the first candidate starts the max; constant once unrolled)
-                    let (mut v, mut first) = (FLOOR_KEY, true);
-                    for (cx, &gx) in gk.iter().enumerate().take(3) {
-                        let pxi = (dxi + 1).wrapping_sub(cx);
-                        if pxi < n {
-                            let i = cell.get(pyi * n + pxi).map_or(C::FLOOR, |c| c.get());
-                            let key = (i << 4) + gx;
-                            v = if first || key > v { key } else { v };
-                            first = false;
-                        }
-                    }
-                    *h = v;
-                }
-            }
-            let (mut acc, mut prev) = (0u32, 0i32);
-            for (d, o) in out.iter_mut().enumerate() {
-                let (dyi, dxi) = (d / n, d % n);
+            Self::j_cell_sep(cell, &gk, out, &mut push);
+        }
+    }
+
+    /// `J` of one pixel when `g` is separable: `J(d) = max_ey [GY(ey) + Hx(d - (0, ey), dx)]`,
+    /// `Hx(p_y, dx) = max_ex [I(p) << 4 + GX(ex)]` (row maxima shared by the states). The
+    /// keys carry `(ey + 1) << 2 | (ex + 1)`, ordered like the candidate index `j` (both
+    /// ascend in `e`), so the winner and its pointer are those of the plain 2-D max.
+    #[inline(always)]
+    fn j_cell_sep(
+        cell: &[C; QB],
+        gk: &[i32; 6],
+        out: &mut [C; QB],
+        push: &mut impl FnMut(u32, u32),
+    ) {
+        let lay = &Self::LAY;
+        let n = Self::N;
+        // hx[p_y][dx] over ex with p_x = dx - ex inside the window
+        let mut hx = [[FLOOR_KEY; 5]; 5];
+        for (pyi, hrow) in hx.iter_mut().enumerate().take(n) {
+            for (dxi, h) in hrow.iter_mut().enumerate().take(n) {
+                // (`first`: the first candidate starts the max; constant once unrolled)
                 let (mut v, mut first) = (FLOOR_KEY, true);
-                for (cy, &gy) in gk.iter().skip(3).enumerate() {
-                    let pyi = (dyi + 1).wrapping_sub(cy);
-                    if pyi < n {
-                        let h = hx
-                            .get(pyi)
-                            .and_then(|h| h.get(dxi))
-                            .map_or(FLOOR_KEY, |&h| h);
-                        let key = h + gy;
+                for (cx, &gx) in gk.iter().enumerate().take(3) {
+                    let pxi = (dxi + 1).wrapping_sub(cx);
+                    if pxi < n {
+                        let i = cell.get(pyi * n + pxi).map_or(C::FLOOR, |c| c.get());
+                        let key = (i << 4) + gx;
                         v = if first || key > v { key } else { v };
                         first = false;
                     }
                 }
-                *o = C::sat(v >> 4);
-                // the chunk's code, sum of j suffix[d] (the candidate index j of the
-                // winner's code, from a table; states 2i - 1, 2i of one chunk as a pair)
-                let last = lay.chunk_last.get(d).copied().unwrap_or(false);
-                let paired = d % 2 == 1 && d + 1 < QB && !last;
-                if d % 2 == 0 && d > 0 && !lay.chunk_last.get(d - 1).copied().unwrap_or(true) {
-                    let c = ((prev & 15) | ((v & 15) << 4)) as usize;
-                    let term = lay.jpair.get(d / 2 - 1).map_or(0, |t| t[c]);
-                    acc = acc.wrapping_add(term);
-                } else if !paired {
-                    let term = lay.jterm.get(d).map_or(0, |t| t[(v & 15) as usize]);
-                    acc = acc.wrapping_add(term);
+                *h = v;
+            }
+        }
+        let (mut acc, mut prev) = (0u32, 0i32);
+        for (d, o) in out.iter_mut().enumerate() {
+            let (dyi, dxi) = (d / n, d % n);
+            let (mut v, mut first) = (FLOOR_KEY, true);
+            for (cy, &gy) in gk.iter().skip(3).enumerate() {
+                let pyi = (dyi + 1).wrapping_sub(cy);
+                if pyi < n {
+                    let h = hx
+                        .get(pyi)
+                        .and_then(|h| h.get(dxi))
+                        .map_or(FLOOR_KEY, |&h| h);
+                    let key = h + gy;
+                    v = if first || key > v { key } else { v };
+                    first = false;
                 }
-                prev = v;
-                if last {
-                    push(acc, u32::from(lay.chunk_bits.get(d).copied().unwrap_or(1)));
-                    acc = 0;
+            }
+            *o = C::sat(v >> 4);
+            // the chunk's code, sum of j suffix[d] (the candidate index j of the
+            // winner's code, from a table; states 2i - 1, 2i of one chunk as a pair)
+            let last = lay.chunk_last.get(d).copied().unwrap_or(false);
+            let paired = d % 2 == 1 && d + 1 < QB && !last;
+            if d % 2 == 0 && d > 0 && !lay.chunk_last.get(d - 1).copied().unwrap_or(true) {
+                let c = ((prev & 15) | ((v & 15) << 4)) as usize;
+                let term = lay.jpair.get(d / 2 - 1).map_or(0, |t| t[c]);
+                acc = acc.wrapping_add(term);
+            } else if !paired {
+                let term = lay.jterm.get(d).map_or(0, |t| t[(v & 15) as usize]);
+                acc = acc.wrapping_add(term);
+            }
+            prev = v;
+            if last {
+                push(acc, u32::from(lay.chunk_bits.get(d).copied().unwrap_or(1)));
+                acc = 0;
+            }
+        }
+    }
+
+    /// `J` of merit row `rr` (`q_B = 9`, separable `g`) written at the target pixels
+    /// `t = t' + d` in the ring of [`Self::run_fast`] (state `d = (dx, dy)` of pixel `x`
+    /// into cell `3 (x + 1 + dx) + (rr + dy) mod 3`); the pixels' pointer codes appended
+    /// to `bw` (on the Cortex-M4 by [`j_row_asm`], else through `codes` with
+    /// [`Self::j_cell_sep`]: the same).
+    #[inline(always)]
+    fn jrow_fast(
+        states: &[[[C; QB]; M]; M],
+        ring: &mut [[C; QB]],
+        rr: usize,
+        gk: &[i32; 6],
+        codes: &mut [i32; M],
+        bw: &mut Option<BitWriter<'_>>,
+    ) {
+        let Some(src) = states.get(rr) else {
+            return;
+        };
+        if ring.len() < 3 * (M + 2) || QB != 9 {
+            return;
+        }
+        #[cfg(target_arch = "arm")]
+        if let Some(w) = bw.as_mut() {
+            let done = match rr % 3 {
+                0 => j_row_asm::<C, QB, M, 0>(src, ring, gk, w),
+                1 => j_row_asm::<C, QB, M, 1>(src, ring, gk, w),
+                _ => j_row_asm::<C, QB, M, 2>(src, ring, gk, w),
+            };
+            if done {
+                return;
+            }
+        }
+        let gk = *gk;
+        let mut o = [C::ZERO; QB];
+        for (x, (cell, code)) in src.iter().zip(codes.iter_mut()).enumerate() {
+            let mut acc = 0u32;
+            Self::j_cell_sep(cell, &gk, &mut o, &mut |c, _| acc = c);
+            *code = acc as i32;
+            let Some(t) = ring.get_mut(3 * x..3 * x + 9) else {
+                continue;
+            };
+            for (s, &v) in o.iter().enumerate().take(9) {
+                let (dyi, dxi) = (s / 3, s % 3);
+                if let Some(c) = t
+                    .get_mut(3 * dxi + (rr + dyi + 2) % 3)
+                    .and_then(|c| c.get_mut(s))
+                {
+                    *c = v;
                 }
             }
         }
+        if let Some(w) = bw.as_mut() {
+            for &c in codes.iter() {
+                w.push(c as u32, Self::LAY.bits);
+            }
+        }
+    }
+
+    /// The fast frame (`q_B = 9`, separable `g`, `k >= 3`): `J` at the target pixels in
+    /// a ring of three padded rows interleaved per pixel (target row `y`, pixel `x` in
+    /// cell `3 (x + 1) + y mod 3` of `jring`), so the new merits read one contiguous cell
+    /// per pixel. Sources outside the image stay at the floor (cells never written).
+    /// Returns the best stored merit and its pixel, and the clamp count.
+    fn run_fast(
+        &mut self,
+        frame: &[f32],
+        sub: i32,
+        slow: bool,
+        gk: &[i32; 6],
+        k: u32,
+    ) -> (i32, (u16, u16), u32) {
+        let floor = C::sat(C::FLOOR);
+        let Self {
+            s: states,
+            jring,
+            zrow,
+            quant,
+            ptr,
+            ..
+        } = self;
+        let slot = (k.saturating_sub(3) as usize) % Self::LP.max(1);
+        let words: &mut [u32] = ptr
+            .get_mut(slot * Self::WF..(slot + 1) * Self::WF)
+            .unwrap_or(&mut []);
+        let mut bw = if words.is_empty() {
+            None
+        } else {
+            Some(BitWriter::new(words))
+        };
+        let ring = jring.as_flattened_mut();
+        let ring = ring.get_mut(..3 * (M + 2)).unwrap_or(&mut []);
+        let fill = |ring: &mut [[C; QB]], cells: core::ops::Range<usize>, st: [usize; 3]| {
+            for c in ring.iter_mut().take(cells.end).skip(cells.start) {
+                for i in st {
+                    if let Some(c) = c.get_mut(i) {
+                        *c = floor;
+                    }
+                }
+            }
+        };
+        // the cells no source writes: pixel 0's states dx = +1, pixel M - 1's dx = -1,
+        // row 0's dy = +1
+        fill(ring, 3..6, [2, 5, 8]);
+        fill(ring, 3 * M..3 * M + 3, [0, 3, 6]);
+        for x in 0..M {
+            fill(ring, 3 * x + 3..3 * x + 4, [6, 7, 8]);
+        }
+        let mut clamped = 0;
+        let (mut best, mut bxy) = (i32::MIN, (0u16, 0u16));
+        // every zq = round(z / lsb) - sub, |round(z / lsb)| <= ZMAX, is a cell value
+        #[cfg(target_arch = "arm")]
+        let q16 = {
+            let cmax = C::sat(i32::MAX).get();
+            sub >= C::ZMAX - cmax && sub <= cmax + 1 - C::ZMAX
+        };
+        Self::jrow_fast(states, ring, 0, gk, zrow, &mut bw);
+        for (y, src) in frame.chunks_exact(M).enumerate() {
+            if y + 1 < M {
+                Self::jrow_fast(states, ring, y + 1, gk, zrow, &mut bw);
+            }
+            clamped += quant.row(src, sub, slow, zrow);
+            let sl = y % 3;
+            if y + 1 == M {
+                // the last row's states dy = -1
+                for x in 0..M {
+                    fill(ring, 3 * x + 3 + sl..3 * x + 4 + sl, [0, 1, 2]);
+                }
+            }
+            let Some(row) = states.get_mut(y) else {
+                continue;
+            };
+            let cells = ring.get(3 + sl..).unwrap_or(&[]);
+            #[cfg(target_arch = "arm")]
+            let asm_rb = scatter_asm::<C, QB, M>(cells, row, zrow, q16);
+            #[cfg(not(target_arch = "arm"))]
+            let asm_rb: Option<i32> = None;
+            let (rb, rx) = match asm_rb {
+                // (the pixel only when the frame's best rises: the first holding it)
+                Some(rb) => (rb, None),
+                None => {
+                    let (mut rb, mut rx) = (i32::MIN, 0usize);
+                    let it = row.iter_mut().zip(zrow.iter()).zip(cells.iter().step_by(3));
+                    for (x, ((cell, &zq), j)) in it.enumerate() {
+                        let mut pb = i32::MIN;
+                        for (c, jv) in cell.iter_mut().zip(j) {
+                            *c = C::sat(zq + jv.get());
+                            let v = c.get();
+                            pb = if v > pb { v } else { pb };
+                        }
+                        if pb > rb {
+                            rb = pb;
+                            rx = x;
+                        }
+                    }
+                    (rb, Some(rx))
+                }
+            };
+            if rb > best {
+                best = rb;
+                let rx = rx.unwrap_or_else(|| {
+                    row.iter()
+                        .position(|c| c.iter().any(|v| v.get() == rb))
+                        .unwrap_or(0)
+                });
+                bxy = (rx as u16, y as u16);
+            }
+        }
+        if let Some(w) = bw {
+            w.finish();
+        }
+        (best, bxy, clamped)
     }
 
     fn run(&mut self, frame: &[f32], slow: bool) {
@@ -469,6 +1055,11 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             let r = Self::R;
             let n = Self::N;
             let plain = k == 2;
+            if let (Some(gk), true) = (self.sep, QB == 9 && !plain && M >= 3) {
+                let (b, xy, c) = self.run_fast(frame, sub, slow, &gk, k);
+                self.tally.advance(sub, b, xy, c);
+                return;
+            }
             let slot = if k >= 3 {
                 ((k - 3) as usize) % Self::LP.max(1)
             } else {
@@ -699,5 +1290,60 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
 
     fn best(&self) -> Option<TrackEnd> {
         self.ends.as_slice().first().copied()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{second_order_words, DpConfig, Method, Transition};
+    use super::{MeritCell, SecondOrderDp};
+    use crate::detect::Detector;
+    use crate::rng::Rng;
+
+    /// The fast frames (separable `g`, `J` at the target pixels) equal the general 2-D
+    /// path exactly: merits, back-pointer words and the best pixel, over frames with
+    /// saturating and clamped values.
+    fn fast_equals_general<C: MeritCell, const M: usize, const W: usize>(lsb: f32, seed: u64) {
+        for transition in [Transition::Gaussian, Transition::Hard] {
+            let mut cfg = DpConfig::dim_point(Method::SecondOrder, 1);
+            cfg.transition = transition;
+            cfg.lsb = lsb;
+            let mut a = SecondOrderDp::<M, 9, 5, W, C>::new(cfg).unwrap_or_else(|_| unreachable!());
+            let mut b = a.clone();
+            assert!(a.sep.is_some());
+            b.sep = None;
+            let mut rng = Rng::seed_from_u64(seed);
+            let mut z = [0f32; 4096];
+            for k in 0..9 {
+                for v in z.iter_mut().take(M * M) {
+                    *v = 1.5 * rng.normal();
+                    if rng.bernoulli(0.05) {
+                        *v *= 40.0;
+                    }
+                    if k == 4 && rng.bernoulli(0.02) {
+                        *v = if rng.bernoulli(0.5) { 1e30 } else { -1e30 };
+                    }
+                }
+                let ra = a.step(&z[..M * M]);
+                let rb = b.step(&z[..M * M]);
+                assert_eq!(ra.is_ok(), rb.is_ok());
+                assert!(a.s == b.s, "merits, frame {k}");
+                assert!(a.ptr == b.ptr, "pointers, frame {k}");
+                assert_eq!(a.tally.best_raw, b.tally.best_raw, "frame {k}");
+                assert_eq!(a.tally.best_xy, b.tally.best_xy, "frame {k}");
+            }
+        }
+    }
+
+    #[test]
+    fn fast_frames_equal_the_general_path() {
+        for seed in 0..3 {
+            fast_equals_general::<i16, 12, { second_order_words(12, 9, 5) }>(0.0625, seed);
+            fast_equals_general::<i8, 12, { second_order_words(12, 9, 5) }>(0.0625, seed);
+            fast_equals_general::<i16, 7, { second_order_words(7, 9, 5) }>(0.0625, seed);
+            fast_equals_general::<i8, 16, { second_order_words(16, 9, 5) }>(0.5, seed);
+            fast_equals_general::<i16, 16, { second_order_words(16, 9, 5) }>(0.001, seed);
+            fast_equals_general::<i16, 3, { second_order_words(3, 9, 5) }>(0.0625, seed);
+        }
     }
 }
