@@ -40,7 +40,8 @@
 //! timer. A block line gives the block's mean and largest count per frame and two
 //! detector-specific block means (work counters: `w1`, `w2`, see [`Spec`]). The peak
 //! stack is the deepest write into a painted 64 KiB window below the soak loop's frame,
-//! read at every block's end: an upper bound on `step`'s stack (it includes the frame
+//! read at every block's end, before the block's line is printed (the window is painted
+//! again after it): an upper bound on `step`'s stack (it includes the frame
 //! generator and the output check).
 #![no_std]
 #![no_main]
@@ -359,6 +360,8 @@ where
                 errors,
                 bad
             );
+            // The print's own stack (float formatting) is not the detector's: repaint.
+            paint(lo, hi);
             blocks += 1;
             b = Block::default();
         }
