@@ -210,7 +210,9 @@ impl<const N: usize> Dbscan<N> {
         }
         {
             let key = &self.key;
-            self.order[..n].sort_unstable_by_key(|&i| (key[i as usize], i));
+            crate::sort::sort_unstable_by_key(&mut self.order[..n], |&i| {
+                (key.get(i as usize).copied().unwrap_or(u64::MAX), i)
+            });
         }
         self.n_runs = 0;
         let mut s = 0usize;

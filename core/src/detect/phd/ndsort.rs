@@ -81,7 +81,10 @@ pub fn rank_sorted<V: Fn(usize, usize) -> f32>(
             *x = p as u32;
             order1[p] = !ordered_bits(val(p, 1));
         }
-        sc.sort_unstable_by_key(|&p| order1[p as usize]);
+        // Ties by position: a total order (the dense ranks do not depend on it).
+        crate::sort::sort_unstable_by_key(sc, |&p| {
+            (order1.get(p as usize).copied().unwrap_or(u32::MAX), p)
+        });
         // Keys to dense ranks in place (the previous key is kept before overwriting).
         let mut d = 0u32;
         let mut prev = order1[sc[0] as usize];
@@ -289,7 +292,14 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
             let p = if i < a.len() { a[i] } else { b[i - a.len()] };
             self.scratch[t] = ordered_bits(self.v(p, o));
         }
-        let (_, &mut m, _) = self.scratch[..take].select_nth_unstable(take / 2);
+        let mid = take / 2;
+        let m = match self.scratch.get_mut(..take) {
+            Some(sc) => {
+                crate::sort::select_nth_unstable(sc, mid);
+                sc.get(mid).copied().unwrap_or(0)
+            }
+            None => 0,
+        };
         let m = from_ordered_bits(m);
         (m, mx <= m)
     }

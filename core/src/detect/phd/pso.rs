@@ -24,6 +24,7 @@
 use super::ndsort;
 use crate::math;
 use crate::rng::Rng;
+use crate::sort;
 
 const NONE: u32 = u32::MAX;
 
@@ -47,6 +48,12 @@ pub fn dominates(a: &[f32], b: &[f32]) -> bool {
         strict |= x > y;
     }
     strict
+}
+
+/// `k[i]` (`u32::MAX` out of range: never, for the callers' indices).
+#[inline(always)]
+fn at(k: &[u32], i: u32) -> u32 {
+    k.get(i as usize).copied().unwrap_or(u32::MAX)
 }
 
 /// Lexicographic "better first" order on objective vectors (descending).
@@ -86,8 +93,12 @@ pub fn non_dominated_sort<const M: usize>(
     for (i, o) in order[..n].iter_mut().enumerate() {
         *o = i as u32;
     }
-    order[..n].sort_unstable_by(|&a, &b| {
-        lex_desc(&f[a as usize][..m], &f[b as usize][..m]).then(a.cmp(&b))
+    sort::sort_unstable_by(&mut order[..n], |&a, &b| {
+        match (f.get(a as usize), f.get(b as usize)) {
+            (Some(fa), Some(fb)) => lex_desc(&fa[..m], &fb[..m]),
+            _ => core::cmp::Ordering::Equal,
+        }
+        .then(a.cmp(&b))
     });
     ens_bs(&order[..n], m <= 2, rank, next, head, |a, b| {
         dominates(&f[a][..m], &f[b][..m])
@@ -172,12 +183,16 @@ pub fn crowding_distance<const M: usize>(
         for (i, o) in order[..n].iter_mut().enumerate() {
             *o = i as u32;
         }
-        order[..n].sort_unstable_by(|&a, &b| {
-            rank[a as usize].cmp(&rank[b as usize]).then(
-                f[a as usize][j]
-                    .partial_cmp(&f[b as usize][j])
-                    .unwrap_or(core::cmp::Ordering::Equal),
-            )
+        // (front, f_j), ties by index: a total order, so the result is defined.
+        let key = |i: u32| {
+            let i = i as usize;
+            (rank.get(i).copied(), f.get(i).map_or(0.0, |r| r[j]))
+        };
+        sort::sort_unstable_by(&mut order[..n], |&a, &b| {
+            let ((ra, fa), (rb, fb)) = (key(a), key(b));
+            ra.cmp(&rb)
+                .then(fa.partial_cmp(&fb).unwrap_or(core::cmp::Ordering::Equal))
+                .then(a.cmp(&b))
         });
         let mut s = 0usize;
         while s < n {
@@ -602,7 +617,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
                         0.0
                     }
                 };
-                self.order[s..e].select_nth_unstable_by(keep - 1, |&a, &b| {
+                sort::select_nth_unstable_by(&mut self.order[s..e], keep - 1, |&a, &b| {
                     key(b)
                         .partial_cmp(&key(a))
                         .unwrap_or(core::cmp::Ordering::Equal)
@@ -620,9 +635,11 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
                 self.aux[i as usize] = !ndsort::ordered_bits(fit[i as usize][j0]);
             }
             let key = &self.aux;
-            self.order[s..e].sort_unstable_by(|&a, &b| {
-                key[a as usize].cmp(&key[b as usize]).then_with(|| {
-                    let (fa, fb) = (&fit[a as usize], &fit[b as usize]);
+            sort::sort_unstable_by(&mut self.order[s..e], |&a, &b| {
+                at(key, a).cmp(&at(key, b)).then_with(|| {
+                    let (Some(fa), Some(fb)) = (fit.get(a as usize), fit.get(b as usize)) else {
+                        return a.cmp(&b);
+                    };
                     for &j in &act[1..] {
                         if fa[j] > fb[j] {
                             return core::cmp::Ordering::Less;
@@ -783,8 +800,9 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
                 self.aux[i as usize] = ndsort::ordered_bits(fit[i as usize][j]);
             }
             let key = &self.aux;
-            members
-                .sort_unstable_by(|&a, &b| key[a as usize].cmp(&key[b as usize]).then(a.cmp(&b)));
+            sort::sort_unstable_by(members, |&a, &b| {
+                at(key, a).cmp(&at(key, b)).then(a.cmp(&b))
+            });
             let lo = fit[members[0] as usize][j];
             let hi = fit[members[len - 1] as usize][j];
             let span = hi - lo;
@@ -805,8 +823,8 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
         if need == 0 || need > len {
             return;
         }
-        members.select_nth_unstable_by(need - 1, |&a, &b| {
-            crowd[b as usize].cmp(&crowd[a as usize]).then(a.cmp(&b))
+        sort::select_nth_unstable_by(members, need - 1, |&a, &b| {
+            at(crowd, b).cmp(&at(crowd, a)).then(a.cmp(&b))
         });
         for &i in &members[..need] {
             self.kept[i as usize] = true;

@@ -64,7 +64,9 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         }
         {
             let key = &self.key;
-            self.order[..n].sort_unstable_by_key(|&i| (key[i as usize], i));
+            crate::sort::sort_unstable_by_key(&mut self.order[..n], |&i| {
+                (key.get(i as usize).copied().unwrap_or(u32::MAX), i)
+            });
         }
         let ln_lambda = math::ln(self.cfg.clutter_lambda);
         // Runs of equal cell; `run_of[i]` for every particle (u32::MAX outside).
