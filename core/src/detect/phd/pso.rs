@@ -50,12 +50,6 @@ pub fn dominates(a: &[f32], b: &[f32]) -> bool {
     strict
 }
 
-/// `k[i]` (`u32::MAX` out of range: never, for the callers' indices).
-#[inline(always)]
-fn at(k: &[u32], i: u32) -> u32 {
-    k.get(i as usize).copied().unwrap_or(u32::MAX)
-}
-
 /// `a[to] = a[from]` (nothing when either is out of range: never, for the callers).
 #[inline(always)]
 fn shift<T: Copy>(a: &mut [T], from: usize, to: usize) {
@@ -353,6 +347,8 @@ pub struct Swarm<const S: usize, const M: usize> {
     next: [u32; S],
     head: [u32; S],
     aux: [u32; S],
+    /// Sort keys `key << 32 | index` (a `u64` sort needs no lookups in the comparator).
+    keys: [u64; S],
     kept: [bool; S],
     /// A group's active objectives by sorted position, for the divide-and-conquer sort
     /// (one contiguous load per value instead of two dependent ones: -7 % instructions
@@ -395,6 +391,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             next: [0; S],
             head: [0; S],
             aux: [0; S],
+            keys: [0; S],
             kept: [false; S],
             objs: [[0.0; DC_OBJECTIVES]; S],
             len: 0,
@@ -677,49 +674,61 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             let Some(members) = self.order.get_mut(s..e) else {
                 continue;
             };
-            let Some((&j0, rest)) = act.split_first().filter(|_| na > 1) else {
+            let Some(keys) = self.keys.get_mut(..members.len()) else {
+                continue;
+            };
+            // Descending by the first active objective, ties by index: `u64` keys
+            // `!bits(f) << 32 | i` (`bits` orders like the values; fitness is never NaN
+            // or -0 for finite positions).
+            let first = |i: u32| act.first().map_or(0.0, |&j| value(i, j));
+            for (k, &i) in keys.iter_mut().zip(members.iter()) {
+                *k = (u64::from(!ndsort::ordered_bits(first(i))) << 32) | u64::from(i);
+            }
+            let Some(rest) = act.get(1..).filter(|_| na > 1) else {
                 // Fronts are the distinct values of the one objective, best first.
-                let key = |i: u32| act.first().map_or(0.0, |&j| value(i, j));
-                sort::select_nth_unstable_by(members, keep - 1, |&a, &b| {
-                    key(b)
-                        .partial_cmp(&key(a))
-                        .unwrap_or(core::cmp::Ordering::Equal)
-                        .then(a.cmp(&b))
-                });
-                for &i in members.iter().take(keep) {
-                    if let Some(k) = self.kept.get_mut(i as usize) {
-                        *k = true;
+                sort::select_nth_unstable(keys, keep - 1);
+                for &k in keys.iter().take(keep) {
+                    if let Some(kept) = self.kept.get_mut(k as u32 as usize) {
+                        *kept = true;
                     }
                 }
                 continue;
             };
-            // Lexicographically descending on the active objectives, ties by index; the
-            // first objective as a precomputed key.
-            for &i in members.iter() {
-                if let Some(a) = self.aux.get_mut(i as usize) {
-                    *a = !ndsort::ordered_bits(value(i, j0));
-                }
+            // Lexicographically descending on the active objectives, ties by index: by
+            // the first objective's keys, then the runs of equal first objective by the
+            // others.
+            sort::sort_unstable(keys);
+            for (m, &k) in members.iter_mut().zip(keys.iter()) {
+                *m = k as u32;
             }
-            let key = &self.aux;
-            sort::sort_unstable_by(members, |&a, &b| {
-                at(key, a).cmp(&at(key, b)).then_with(|| {
-                    let (Some(fa), Some(fb)) = (fit.get(a as usize), fit.get(b as usize)) else {
-                        return a.cmp(&b);
-                    };
-                    for &j in rest {
-                        let (Some(&x), Some(&y)) = (fa.get(j), fb.get(j)) else {
-                            break;
+            let mut a = 0usize;
+            while let Some(&ka) = keys.get(a) {
+                let mut b = a + 1;
+                while keys.get(b).is_some_and(|&kb| kb >> 32 == ka >> 32) {
+                    b += 1;
+                }
+                if let Some(run) = members.get_mut(a..b).filter(|r| r.len() > 1) {
+                    sort::sort_unstable_by(run, |&x, &y| {
+                        let (Some(fx), Some(fy)) = (fit.get(x as usize), fit.get(y as usize))
+                        else {
+                            return x.cmp(&y);
                         };
-                        if x > y {
-                            return core::cmp::Ordering::Less;
+                        for &j in rest {
+                            let (Some(&u), Some(&v)) = (fx.get(j), fy.get(j)) else {
+                                break;
+                            };
+                            if u > v {
+                                return core::cmp::Ordering::Less;
+                            }
+                            if u < v {
+                                return core::cmp::Ordering::Greater;
+                            }
                         }
-                        if x < y {
-                            return core::cmp::Ordering::Greater;
-                        }
-                    }
-                    a.cmp(&b)
-                })
-            });
+                        x.cmp(&y)
+                    });
+                }
+                a = b;
+            }
             // Two objectives: ENS-BS checking one member per front; three or four: the
             // divide-and-conquer sort; five or more: ENS-BS with full front checks (the
             // divide-and-conquer's `log^(M-1) N` factor outgrows it at these group
@@ -916,15 +925,16 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
                     .copied()
                     .unwrap_or(0.0)
             };
-            for &i in members.iter() {
-                if let Some(a) = self.aux.get_mut(i as usize) {
-                    *a = ndsort::ordered_bits(fj(i));
-                }
+            let Some(keys) = self.keys.get_mut(..members.len()) else {
+                return;
+            };
+            for (k, &i) in keys.iter_mut().zip(members.iter()) {
+                *k = (u64::from(ndsort::ordered_bits(fj(i))) << 32) | u64::from(i);
             }
-            let key = &self.aux;
-            sort::sort_unstable_by(members, |&a, &b| {
-                at(key, a).cmp(&at(key, b)).then(a.cmp(&b))
-            });
+            sort::sort_unstable(keys);
+            for (m, &k) in members.iter_mut().zip(keys.iter()) {
+                *m = k as u32;
+            }
             let (Some(&lo), Some(&hi)) = (members.first(), members.last()) else {
                 continue;
             };
@@ -946,16 +956,21 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
                 }
             }
         }
-        let crowd = &self.crowd;
         if need == 0 || need > len {
             return;
         }
-        sort::select_nth_unstable_by(members, need - 1, |&a, &b| {
-            at(crowd, b).cmp(&at(crowd, a)).then(a.cmp(&b))
-        });
-        for &i in members.iter().take(need) {
-            if let Some(k) = self.kept.get_mut(i as usize) {
-                *k = true;
+        // Most isolated first, ties by index: keys `!crowd << 32 | i`.
+        let Some(keys) = self.keys.get_mut(..members.len()) else {
+            return;
+        };
+        for (k, &i) in keys.iter_mut().zip(members.iter()) {
+            let c = self.crowd.get(i as usize).copied().unwrap_or(0);
+            *k = (u64::from(!c) << 32) | u64::from(i);
+        }
+        sort::select_nth_unstable(keys, need - 1);
+        for &k in keys.iter().take(need) {
+            if let Some(kept) = self.kept.get_mut(k as u32 as usize) {
+                *kept = true;
             }
         }
     }

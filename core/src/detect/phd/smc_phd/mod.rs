@@ -224,7 +224,7 @@ pub struct PhdReport {
 /// swarm entries (parents plus children, so up to `S / 2` particles move), `M`
 /// measurement points (PSO objectives), `K` extracted targets.
 ///
-/// Memory: about `123 N + (56 + 4 M) S` bytes (32-bit target; e.g. 864 KB at
+/// Memory: about `123 N + (64 + 4 M) S` bytes (32-bit target; e.g. 897 KB at
 /// `N = S = 4096, M = 8`): build large instances in a `Box`, or zeroed in a `static` and
 /// set up by [`Detector::configure`].
 #[derive(Debug, Clone)]
