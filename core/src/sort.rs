@@ -301,6 +301,29 @@ mod tests {
     }
 
     #[test]
+    fn select_edge_cases() {
+        // k out of range: unchanged
+        let mut v = std::vec![3u32, 1, 2];
+        select_nth_unstable(&mut v, 3);
+        assert_eq!(v, [3, 1, 2]);
+        let mut e: [u32; 0] = [];
+        select_nth_unstable(&mut e, 0);
+        // an inconsistent comparator gives a permutation
+        let mut v: Vec<u32> = (0..500).collect();
+        let mut k = 7u32;
+        select_nth_unstable_by(&mut v, 250, |_, _| {
+            k = k.wrapping_mul(1_103_515_245).wrapping_add(12345);
+            if k >> 31 == 0 {
+                Ordering::Less
+            } else {
+                Ordering::Greater
+            }
+        });
+        v.sort();
+        assert_eq!(v, (0..500).collect::<Vec<_>>());
+    }
+
+    #[test]
     fn heapsort_alone_sorts() {
         let mut v: Vec<u32> = (0..300u32).map(|i| i.wrapping_mul(2_654_435_761)).collect();
         let mut want = v.clone();

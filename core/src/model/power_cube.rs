@@ -118,7 +118,10 @@ impl CubeGeometry {
         ) else {
             return (0, 0, 0);
         };
-        match (rest.checked_div(self.n_doppler), rest.checked_rem(self.n_doppler)) {
+        match (
+            rest.checked_div(self.n_doppler),
+            rest.checked_rem(self.n_doppler),
+        ) {
             (Some(ir), Some(jd)) => (ir, jd, lb),
             _ => (0, 0, 0),
         }

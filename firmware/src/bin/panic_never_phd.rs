@@ -363,13 +363,29 @@ fn helpers(
             |_| {},
         )
         .is_err();
-    ok &= kmeans.run(pts.get(..n).unwrap_or(&[]), black_box(3), black_box(20), rng).is_ok();
-    ok &= kmeans.run(pts.get(..n).unwrap_or(&[]), black_box(9), black_box(20), rng).is_ok();
+    ok &= kmeans
+        .run(
+            pts.get(..n).unwrap_or(&[]),
+            black_box(3),
+            black_box(20),
+            rng,
+        )
+        .is_ok();
+    ok &= kmeans
+        .run(
+            pts.get(..n).unwrap_or(&[]),
+            black_box(9),
+            black_box(20),
+            rng,
+        )
+        .is_ok();
     ok &= kmeans.run(&pts, 3, 20, rng).is_err();
     if let Some(p) = pts.get_mut(black_box(7)) {
         *p = [f32::NAN, 0.0];
     }
-    ok &= dbscan.run(pts.get(..n).unwrap_or(&[]), &params, |_| {}).is_err();
+    ok &= dbscan
+        .run(pts.get(..n).unwrap_or(&[]), &params, |_| {})
+        .is_err();
     ok &= kmeans.run(pts.get(..n).unwrap_or(&[]), 3, 20, rng).is_err();
     black_box(members);
     ok

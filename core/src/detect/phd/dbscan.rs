@@ -276,7 +276,11 @@ impl<const N: usize> Dbscan<N> {
             clusters += 1;
             let start = qlen;
             self.labels[p] = id;
-            if let Some(f) = self.run_of.get(p).and_then(|&r| self.run_free.get_mut(r as usize)) {
+            if let Some(f) = self
+                .run_of
+                .get(p)
+                .and_then(|&r| self.run_free.get_mut(r as usize))
+            {
                 *f -= 1;
             }
             if let Some(slot) = self.queue.get_mut(qlen) {

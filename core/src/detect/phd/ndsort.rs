@@ -265,10 +265,9 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
                 }
             }
             // In one lexicographic list every earlier solution has objective 0 `>=`.
-            let (Some(&at), Some(r)) = (
-                self.order1.get(hh as usize),
-                self.rank.get_mut(hh as usize),
-            ) else {
+            let (Some(&at), Some(r)) =
+                (self.order1.get(hh as usize), self.rank.get_mut(hh as usize))
+            else {
                 continue;
             };
             let at = at as usize;
@@ -281,7 +280,11 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
                 fenwick_set(self.fenwick, at, r + 1);
             }
         }
-        let inserted = if same { h } else { l.get(..next_l).unwrap_or(l) };
+        let inserted = if same {
+            h
+        } else {
+            l.get(..next_l).unwrap_or(l)
+        };
         for &p in inserted {
             if let Some(&o) = self.order1.get(p as usize) {
                 fenwick_clear(self.fenwick, o as usize);

@@ -121,8 +121,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                     let (sb, cb) = (math::sin(az), math::cos(az));
                     let mut vt = tang * self.rng.normal();
                     for _ in 0..np.min(4) {
-                        let Some(&(pidx, _)) = prev.get(self.rng.below(np as u32) as usize)
-                        else {
+                        let Some(&(pidx, _)) = prev.get(self.rng.below(np as u32) as usize) else {
                             break;
                         };
                         let (pr, _, pl) = g.unindex(pidx);

@@ -235,7 +235,9 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             }
         }
         for ((&slot, &s), &w) in self.order.iter().zip(&self.scratch).zip(&self.lw).take(n_s) {
-            if let (Some(x), Some(wt)) = (self.x.get_mut(slot as usize), self.w.get_mut(slot as usize)) {
+            if let (Some(x), Some(wt)) =
+                (self.x.get_mut(slot as usize), self.w.get_mut(slot as usize))
+            {
                 (*x, *wt) = (s, w);
             }
         }
