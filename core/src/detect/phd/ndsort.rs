@@ -253,10 +253,7 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
         for &hh in h {
             if !same {
                 let x0 = self.v(hh, 0);
-                while let Some(&lp) = l.get(next_l) {
-                    if !(self.v(lp, 0) >= x0) {
-                        break;
-                    }
+                while let Some(&lp) = l.get(next_l).filter(|&&lp| self.v(lp, 0) >= x0) {
                     let p = lp as usize;
                     if let (Some(&o), Some(&r)) = (self.order1.get(p), self.rank.get(p)) {
                         fenwick_set(self.fenwick, o as usize, r + 1);

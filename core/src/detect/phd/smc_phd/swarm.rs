@@ -78,7 +78,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                 let (Some(&tp), Some(&ap)) = (top.get(p - 1), amp.get(p - 1)) else {
                     break;
                 };
-                if !(tp.0 < z) {
+                if tp.0.partial_cmp(&z) != Some(core::cmp::Ordering::Less) {
                     break;
                 }
                 if let (Some(t), Some(a)) = (top.get_mut(p), amp.get_mut(p)) {
