@@ -980,24 +980,3 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
         }
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `len` is public: a swarm set past its parent capacity runs on the first `S / 2`
-    /// parents instead of writing children past `S` (it indexed out of bounds before).
-    #[test]
-    fn run_clamps_len_to_capacity() {
-        let mut sw = Swarm::<8, 2>::new();
-        for i in 0..4u32 {
-            assert!(sw.push([i as f32, 0.0], 0.25, i, 0));
-        }
-        assert!(!sw.push([9.0, 9.0], 0.25, 9, 0));
-        sw.len = 8;
-        let mut rng = Rng::seed_from_u64(1);
-        let r = sw.run(&PsoConfig::paper(), &[[1.0, 0.0], [2.0, 0.0]], &mut rng);
-        assert_eq!(r.generations, PsoConfig::paper().generations);
-        assert_eq!(sw.best_objective(99, 2), (0, f32::NEG_INFINITY));
-    }
-}
