@@ -58,7 +58,9 @@ pub fn cube_returns(
         *o = k as u32;
     }
     // A stable sort by cell without allocation: sort the positions by (cell, position).
-    order.sort_unstable_by_key(|&k| (cells.get(k as usize).map_or(usize::MAX, |c| c.0), k));
+    crate::sort::sort_unstable_by_key(order, |&k| {
+        (cells.get(k as usize).map_or(usize::MAX, |c| c.0), k)
+    });
     let sd = math::sqrt(noise_var);
     let mut i = 0;
     while i < n {

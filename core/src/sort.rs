@@ -54,6 +54,51 @@ pub fn sort_unstable<T: Copy + Ord>(v: &mut [T]) {
     introsort(v, &mut |a: &T, b: &T| a < b);
 }
 
+/// Reorders `v` so that `v[k]` is the element a sort by `cmp` would put there, with
+/// `v[..k] <= v[k] <= v[k + 1..]` (introselect: quickselect with the sort's partition,
+/// heapsort of a range still large after `2 floor(log2 n) + 2` partitions). Does nothing
+/// when `k >= v.len()`. With a total order without ties the set `v[..k]` is the unique
+/// `k` smallest, as with `core`'s `select_nth_unstable_by`. `O(n)` expected, `O(n log n)`
+/// worst case, no allocation, no panic.
+pub fn select_nth_unstable_by<T: Copy, F>(v: &mut [T], k: usize, mut cmp: F)
+where
+    F: FnMut(&T, &T) -> Ordering,
+{
+    introselect(v, k, &mut |a: &T, b: &T| cmp(a, b) == Ordering::Less);
+}
+
+/// [`select_nth_unstable_by`] by `Ord`.
+pub fn select_nth_unstable<T: Copy + Ord>(v: &mut [T], k: usize) {
+    introselect(v, k, &mut |a: &T, b: &T| a < b);
+}
+
+fn introselect<T: Copy, F: FnMut(&T, &T) -> bool>(v: &mut [T], k: usize, is_less: &mut F) {
+    let mut depth = 2 * (usize::BITS - v.len().leading_zeros());
+    let (mut lo, mut hi) = (0usize, v.len());
+    // invariant: lo <= k < hi, and v[..lo] <= v[lo..hi] <= v[hi..]
+    while k >= lo && k < hi {
+        let Some(s) = v.get_mut(lo..hi) else {
+            return;
+        };
+        if s.len() <= SMALL {
+            insertion_sort(s, is_less);
+            return;
+        }
+        if depth == 0 {
+            heapsort(s, is_less);
+            return;
+        }
+        depth -= 1;
+        // s[..p] <= s[p] <= s[p + 1..]
+        let p = lo + partition(s, is_less);
+        if k < p {
+            hi = p;
+        } else {
+            lo = p + 1;
+        }
+    }
+}
+
 /// Swaps `v[i]` and `v[j]` when both are in range (always, for the callers below).
 #[inline(always)]
 fn swap<T>(v: &mut [T], i: usize, j: usize) {
@@ -256,6 +301,29 @@ mod tests {
     }
 
     #[test]
+    fn select_edge_cases() {
+        // k out of range: unchanged
+        let mut v = std::vec![3u32, 1, 2];
+        select_nth_unstable(&mut v, 3);
+        assert_eq!(v, [3, 1, 2]);
+        let mut e: [u32; 0] = [];
+        select_nth_unstable(&mut e, 0);
+        // an inconsistent comparator gives a permutation
+        let mut v: Vec<u32> = (0..500).collect();
+        let mut k = 7u32;
+        select_nth_unstable_by(&mut v, 250, |_, _| {
+            k = k.wrapping_mul(1_103_515_245).wrapping_add(12345);
+            if k >> 31 == 0 {
+                Ordering::Less
+            } else {
+                Ordering::Greater
+            }
+        });
+        v.sort();
+        assert_eq!(v, (0..500).collect::<Vec<_>>());
+    }
+
+    #[test]
     fn heapsort_alone_sorts() {
         let mut v: Vec<u32> = (0..300u32).map(|i| i.wrapping_mul(2_654_435_761)).collect();
         let mut want = v.clone();
@@ -296,6 +364,26 @@ mod tests {
             let mut by_key: Vec<u16> = (0..keys.len() as u16).rev().collect();
             sort_unstable_by_key(&mut by_key, |&i| (xs[i as usize], i));
             prop_assert_eq!(&by_key, &want);
+        }
+
+        #[test]
+        fn select_matches_std(xs in proptest::collection::vec(-50i32..50, 1..300), k in 0usize..300) {
+            let k = k % xs.len();
+            let cmp = |a: &u16, b: &u16| xs[*a as usize].cmp(&xs[*b as usize]).then(a.cmp(b));
+            let mut want: Vec<u16> = (0..xs.len() as u16).collect();
+            want.select_nth_unstable_by(k, cmp);
+            let mut got: Vec<u16> = (0..xs.len() as u16).rev().collect();
+            select_nth_unstable_by(&mut got, k, cmp);
+            prop_assert_eq!(got[k], want[k]);
+            let (mut a, mut b) = (got[..k].to_vec(), want[..k].to_vec());
+            a.sort();
+            b.sort();
+            prop_assert_eq!(a, b);
+            let mut vals: Vec<i32> = xs.clone();
+            select_nth_unstable(&mut vals, k);
+            let mut sorted = xs.clone();
+            sorted.sort();
+            prop_assert_eq!(vals[k], sorted[k]);
         }
 
         #[test]

@@ -355,6 +355,25 @@ fn track_recovery_with_fewer_flag_rows_than_scans_is_total() {
 }
 
 #[test]
+fn swarm_run_with_len_past_its_capacity_is_total() {
+    // `Swarm::len` is public: set past the parent capacity `S / 2`, `run` wrote children
+    // past `S` (index out of bounds; found by the `panic-never-phd` link check). It now
+    // runs on the first `S / 2` parents; `best_objective` past `S` is objective 0.
+    use faint::core::detect::phd::pso::{PsoConfig, Swarm};
+    let mut sw = Swarm::<8, 2>::new();
+    for i in 0..4u32 {
+        assert!(sw.push([i as f32, 0.0], 0.25, i, 0));
+    }
+    assert!(!sw.push([9.0, 9.0], 0.25, 9, 0));
+    sw.len = 8;
+    let mut rng = Rng::seed_from_u64(1);
+    let r = sw.run(&PsoConfig::paper(), &[[1.0, 0.0], [2.0, 0.0]], &mut rng);
+    assert_eq!(r.generations, PsoConfig::paper().generations);
+    assert!(sw.pos.iter().all(|p| p.iter().all(|v| v.is_finite())));
+    assert_eq!(sw.best_objective(99, 2), (0, f32::NEG_INFINITY));
+}
+
+#[test]
 fn censoring_with_a_gate_wider_than_the_area_is_bounded() {
     // A gate of 1e10 m with m = 6 made every pair of plots a candidate and the chain
     // search visit up to P^5 partial chains (2.9 s for one scan; fuzz corpus

@@ -111,9 +111,20 @@ impl CubeGeometry {
     /// Inverse of [`CubeGeometry::index`].
     #[inline]
     pub const fn unindex(&self, idx: usize) -> (usize, usize, usize) {
-        let lb = idx % self.n_azimuth;
-        let rest = idx / self.n_azimuth;
-        (rest / self.n_doppler, rest % self.n_doppler, lb)
+        // `checked_*`: no division-by-zero path for an unvalidated zero size.
+        let (Some(lb), Some(rest)) = (
+            idx.checked_rem(self.n_azimuth),
+            idx.checked_div(self.n_azimuth),
+        ) else {
+            return (0, 0, 0);
+        };
+        match (
+            rest.checked_div(self.n_doppler),
+            rest.checked_rem(self.n_doppler),
+        ) {
+            (Some(ir), Some(jd)) => (ir, jd, lb),
+            _ => (0, 0, 0),
+        }
     }
 
     /// Centre of range cell `i`.

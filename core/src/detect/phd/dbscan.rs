@@ -94,7 +94,9 @@ impl<const N: usize> Dbscan<N> {
     /// First run with key >= `k`.
     #[inline]
     fn lower_run(&self, k: u64) -> usize {
-        self.run_key[..self.n_runs].partition_point(|&x| x < k)
+        self.run_key
+            .get(..self.n_runs)
+            .map_or(0, |r| r.partition_point(|&x| x < k))
     }
 
     /// Calls `f(run)` for the runs of the 5 x 5 grid block around grid cell `(gx, gy)`.
@@ -109,7 +111,7 @@ impl<const N: usize> Dbscan<N> {
             let yhi = (gy as i64 + 2).min(u32::MAX as i64) as u32;
             let mut r = self.lower_run(pack(x as u32, ylo));
             let end = pack(x as u32, yhi);
-            while r < self.n_runs && self.run_key[r] <= end {
+            while r < self.n_runs && self.run_key.get(r).is_some_and(|&k| k <= end) {
                 if !f(r) {
                     return;
                 }
@@ -118,27 +120,46 @@ impl<const N: usize> Dbscan<N> {
         }
     }
 
-    fn is_core(&mut self, p: usize, pts: &[[f32; 2]], eps2: f32, min_pts: usize) -> bool {
-        if self.core[p] != 0 {
-            return self.core[p] == 1;
+    /// The points of run `r` (empty out of range).
+    #[inline]
+    fn members(&self, r: usize) -> &[u32] {
+        match (self.run_start.get(r), self.run_len.get(r)) {
+            (Some(&s), Some(&l)) => {
+                let s = s as usize;
+                self.order.get(s..s + l as usize).unwrap_or(&[])
+            }
+            _ => &[],
         }
-        let own = self.run_of[p] as usize;
+    }
+
+    fn is_core(&mut self, p: usize, pts: &[[f32; 2]], eps2: f32, min_pts: usize) -> bool {
+        let (Some(&cp), Some(&own), Some(&k), Some(&pp)) = (
+            self.core.get(p),
+            self.run_of.get(p),
+            self.key.get(p),
+            pts.get(p),
+        ) else {
+            return false;
+        };
+        if cp != 0 {
+            return cp == 1;
+        }
+        let own = own as usize;
         // With the shortcut every point of the own cell is a neighbour; without it the
         // own cell is searched like the others.
         let (own, mut count) = if self.shortcut {
-            (own, self.run_len[own] as usize)
+            (own, self.run_len.get(own).map_or(0, |&l| l as usize))
         } else {
             (usize::MAX, 0)
         };
         if count < min_pts {
-            let k = self.key[p];
             let (gx, gy) = ((k >> 32) as u32, k as u32);
-            let pp = pts[p];
             self.for_block(gx, gy, |r| {
                 if r != own {
-                    let s = self.run_start[r] as usize;
-                    for &q in &self.order[s..s + self.run_len[r] as usize] {
-                        let q = pts[q as usize];
+                    for &q in self.members(r) {
+                        let Some(q) = pts.get(q as usize) else {
+                            continue;
+                        };
                         let (dx, dy) = (q[0] - pp[0], q[1] - pp[1]);
                         if dx * dx + dy * dy <= eps2 {
                             count += 1;
@@ -149,7 +170,9 @@ impl<const N: usize> Dbscan<N> {
             });
         }
         let c = count >= min_pts;
-        self.core[p] = if c { 1 } else { 2 };
+        if let Some(cp) = self.core.get_mut(p) {
+            *cp = if c { 1 } else { 2 };
+        }
         c
     }
 
@@ -210,24 +233,34 @@ impl<const N: usize> Dbscan<N> {
         }
         {
             let key = &self.key;
-            self.order[..n].sort_unstable_by_key(|&i| (key[i as usize], i));
+            crate::sort::sort_unstable_by_key(&mut self.order[..n], |&i| {
+                (key.get(i as usize).copied().unwrap_or(u64::MAX), i)
+            });
         }
         self.n_runs = 0;
         let mut s = 0usize;
-        while s < n {
-            let k = self.key[self.order[s] as usize];
+        let order = &self.order[..n];
+        while let Some(&first) = order.get(s) {
+            let k = self.key.get(first as usize).copied().unwrap_or(0);
             let mut e = s;
-            while e < n && self.key[self.order[e] as usize] == k {
-                self.run_of[self.order[e] as usize] = self.n_runs as u32;
+            while let Some(&o) = order.get(e) {
+                match (self.key.get(o as usize), self.run_of.get_mut(o as usize)) {
+                    (Some(&ko), Some(ro)) if ko == k => *ro = self.n_runs as u32,
+                    _ => break,
+                }
                 e += 1;
             }
             let r = self.n_runs;
-            self.run_start[r] = s as u32;
-            self.run_len[r] = (e - s) as u32;
-            self.run_free[r] = (e - s) as u32;
-            self.run_key[r] = k;
+            if let (Some(rs), Some(rl), Some(rf), Some(rk)) = (
+                self.run_start.get_mut(r),
+                self.run_len.get_mut(r),
+                self.run_free.get_mut(r),
+                self.run_key.get_mut(r),
+            ) {
+                (*rs, *rl, *rf, *rk) = (s as u32, (e - s) as u32, (e - s) as u32, k);
+            }
             self.n_runs += 1;
-            s = e;
+            s = e.max(s + 1);
         }
         let mut clusters = 0usize;
         let mut qlen = 0usize;
@@ -243,20 +276,31 @@ impl<const N: usize> Dbscan<N> {
             clusters += 1;
             let start = qlen;
             self.labels[p] = id;
-            self.run_free[self.run_of[p] as usize] -= 1;
-            self.queue[qlen] = p as u32;
+            if let Some(f) = self
+                .run_of
+                .get(p)
+                .and_then(|&r| self.run_free.get_mut(r as usize))
+            {
+                *f -= 1;
+            }
+            if let Some(slot) = self.queue.get_mut(qlen) {
+                *slot = p as u32;
+            }
             qlen += 1;
             let mut head = start;
-            while head < qlen {
-                let q = self.queue[head] as usize;
+            while let Some(&q) = self.queue.get(head).filter(|_| head < qlen) {
+                let q = q as usize;
                 head += 1;
                 if !self.is_core(q, pts, eps2, params.min_pts) {
                     continue;
                 }
-                let k = self.key[q];
+                let (Some(&k), Some(&pq), Some(&own)) =
+                    (self.key.get(q), pts.get(q), self.run_of.get(q))
+                else {
+                    continue;
+                };
                 let (gx, gy) = ((k >> 32) as u32, k as u32);
-                let pq = pts[q];
-                let own = self.run_of[q] as usize;
+                let own = own as usize;
                 let mut r_lo = 0usize;
                 // Collect the block's runs first (borrowck: for_block borrows self).
                 let mut runs = [0u32; 25];
@@ -267,30 +311,42 @@ impl<const N: usize> Dbscan<N> {
                     }
                     true
                 });
-                for &r in &runs[..r_lo] {
+                for &r in runs.iter().take(r_lo) {
                     let r = r as usize;
-                    if self.run_free[r] == 0 {
+                    if self.run_free.get(r).is_none_or(|&f| f == 0) {
                         continue;
                     }
-                    let st = self.run_start[r] as usize;
-                    for t in st..st + self.run_len[r] as usize {
-                        let o = self.order[t] as usize;
-                        let lab = self.labels[o];
-                        if lab != UNVISITED && lab != NOISE {
+                    let (Some(&st), Some(&len)) = (self.run_start.get(r), self.run_len.get(r))
+                    else {
+                        continue;
+                    };
+                    let st = st as usize;
+                    let Some(members) = self.order.get(st..st + len as usize) else {
+                        continue;
+                    };
+                    for &o in members {
+                        let o = o as usize;
+                        let (Some(lab), Some(po)) = (self.labels.get_mut(o), pts.get(o)) else {
+                            continue;
+                        };
+                        if *lab != UNVISITED && *lab != NOISE {
                             continue;
                         }
-                        let po = pts[o];
                         let (dx, dy) = (po[0] - pq[0], po[1] - pq[1]);
                         if (self.shortcut && r == own) || dx * dx + dy * dy <= eps2 {
-                            self.labels[o] = id;
-                            self.run_free[r] -= 1;
-                            self.queue[qlen] = o as u32;
+                            *lab = id;
+                            if let Some(f) = self.run_free.get_mut(r) {
+                                *f -= 1;
+                            }
+                            if let Some(slot) = self.queue.get_mut(qlen) {
+                                *slot = o as u32;
+                            }
                             qlen += 1;
                         }
                     }
                 }
             }
-            on_cluster(&self.queue[start..qlen]);
+            on_cluster(self.queue.get(start..qlen).unwrap_or(&[]));
         }
         Ok(clusters)
     }

@@ -50,7 +50,7 @@ impl<const N: usize, const K: usize> KMeans<N, K> {
     #[inline]
     fn nearest_d2(&self, p: [f32; 2], c: usize) -> f32 {
         let mut dn = f32::INFINITY;
-        for &q in &self.centres[..c] {
+        for &q in self.centres.iter().take(c) {
             dn = dn.min(d2(p, q));
         }
         dn
@@ -83,7 +83,9 @@ impl<const N: usize, const K: usize> KMeans<N, K> {
             }
         }
         // k-means++ seeding.
-        self.centres[0] = pts[(rng.below(n as u32) as usize).min(n - 1)];
+        if let Some(&p) = pts.get((rng.below(n as u32) as usize).min(n - 1)) {
+            self.centres[0] = p;
+        }
         for c in 1..k {
             let mut total = 0.0f64;
             for &p in pts {
@@ -101,14 +103,16 @@ impl<const N: usize, const K: usize> KMeans<N, K> {
                     }
                 }
             }
-            self.centres[c] = pts[pick];
+            if let (Some(slot), Some(&p)) = (self.centres.get_mut(c), pts.get(pick)) {
+                *slot = p;
+            }
         }
         for a in self.assign[..n].iter_mut() {
             *a = u16::MAX;
         }
         for _ in 0..max_iter.max(1) {
             let mut changed = false;
-            for (i, &p) in pts.iter().enumerate() {
+            for (&p, a) in pts.iter().zip(self.assign.iter_mut()) {
                 let mut best = (0usize, f32::INFINITY);
                 for (c, &q) in self.centres[..k].iter().enumerate() {
                     let d = d2(p, q);
@@ -116,18 +120,20 @@ impl<const N: usize, const K: usize> KMeans<N, K> {
                         best = (c, d);
                     }
                 }
-                if self.assign[i] as usize != best.0 {
-                    self.assign[i] = best.0 as u16;
+                if *a as usize != best.0 {
+                    *a = best.0 as u16;
                     changed = true;
                 }
             }
             let mut sums = [[0.0f64; 2]; K];
             self.counts = [0; K];
-            for (i, &p) in pts.iter().enumerate() {
-                let c = self.assign[i] as usize;
-                sums[c][0] += p[0] as f64;
-                sums[c][1] += p[1] as f64;
-                self.counts[c] += 1;
+            for (&p, &a) in pts.iter().zip(self.assign.iter()) {
+                let c = a as usize;
+                if let (Some(s), Some(n)) = (sums.get_mut(c), self.counts.get_mut(c)) {
+                    s[0] += p[0] as f64;
+                    s[1] += p[1] as f64;
+                    *n += 1;
+                }
             }
             for c in 0..k {
                 if self.counts[c] > 0 {

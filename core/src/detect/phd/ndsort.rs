@@ -77,30 +77,40 @@ pub fn rank_sorted<V: Fn(usize, usize) -> f32>(
     // Dense descending rank of objective 1 (0 = largest), the sweeps' Fenwick index.
     if k >= 2 {
         let sc = &mut scratch[..n];
-        for (p, x) in sc.iter_mut().enumerate() {
+        for (p, (x, o)) in sc.iter_mut().zip(order1.iter_mut()).enumerate() {
             *x = p as u32;
-            order1[p] = !ordered_bits(val(p, 1));
+            *o = !ordered_bits(val(p, 1));
         }
-        sc.sort_unstable_by_key(|&p| order1[p as usize]);
+        // Ties by position: a total order (the dense ranks do not depend on it).
+        crate::sort::sort_unstable_by_key(sc, |&p| {
+            (order1.get(p as usize).copied().unwrap_or(u32::MAX), p)
+        });
         // Keys to dense ranks in place (the previous key is kept before overwriting).
         let mut d = 0u32;
-        let mut prev = order1[sc[0] as usize];
+        let mut prev = sc
+            .first()
+            .and_then(|&p| order1.get(p as usize))
+            .copied()
+            .unwrap_or(0);
         for &p in sc.iter() {
-            let key = order1[p as usize];
-            if key != prev {
-                d += 1;
-                prev = key;
+            if let Some(o) = order1.get_mut(p as usize) {
+                if *o != prev {
+                    d += 1;
+                    prev = *o;
+                }
+                *o = d;
             }
-            order1[p as usize] = d;
         }
     }
     // Unique vectors only; duplicates copy their first copy's rank afterwards.
     let mut u = 0usize;
-    for p in 0..n {
-        rank[p] = 0;
-        fenwick[p] = 0;
+    for (p, (r, f)) in rank.iter_mut().zip(fenwick.iter_mut()).take(n).enumerate() {
+        *r = 0;
+        *f = 0;
         if p == 0 || !equal_prev(p) {
-            work[u] = p as u32;
+            if let Some(w) = work.get_mut(u) {
+                *w = p as u32;
+            }
             u += 1;
         }
     }
@@ -111,7 +121,7 @@ pub fn rank_sorted<V: Fn(usize, usize) -> f32>(
         order1: &order1[..n],
         fenwick: &mut fenwick[..n],
     };
-    ctx.helper_a(&mut work[..u], k);
+    ctx.helper_a(work.get_mut(..u).unwrap_or(&mut []), k);
     let mut fronts = 0u32;
     for p in 0..n {
         if p > 0 && equal_prev(p) {
@@ -146,10 +156,13 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
 
     #[inline]
     fn raise(&mut self, h: u32, from: u32) {
-        let r = self.rank[from as usize] + 1;
-        let t = &mut self.rank[h as usize];
-        if r > *t {
-            *t = r;
+        let Some(&r) = self.rank.get(from as usize) else {
+            return;
+        };
+        if let Some(t) = self.rank.get_mut(h as usize) {
+            if r + 1 > *t {
+                *t = r + 1;
+            }
         }
     }
 
@@ -181,8 +194,7 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
         }
         let (p, ge) = self.pivot(s, &[], o, mx);
         let nb = self.partition(s, o, p, ge);
-        {
-            let (b, w) = s.split_at_mut(nb);
+        if let Some((b, w)) = s.split_at_mut_checked(nb) {
             self.helper_a(b, k);
             self.helper_b(b, w, k - 1);
             self.helper_a(w, k);
@@ -221,9 +233,9 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
         let (p, ge) = self.pivot(l, h, o, if mxl > mxh { mxl } else { mxh });
         let nl = self.partition(l, o, p, ge);
         let nh = self.partition(h, o, p, ge);
+        if let (Some((l1, l2)), Some((h1, h2))) =
+            (l.split_at_mut_checked(nl), h.split_at_mut_checked(nh))
         {
-            let (l1, l2) = l.split_at_mut(nl);
-            let (h1, h2) = h.split_at_mut(nh);
             self.helper_b(l1, h1, k);
             self.helper_b(l1, h2, k - 1);
             self.helper_b(l2, h2, k);
@@ -241,25 +253,39 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
         for &hh in h {
             if !same {
                 let x0 = self.v(hh, 0);
-                while next_l < l.len() && self.v(l[next_l], 0) >= x0 {
-                    let p = l[next_l] as usize;
-                    fenwick_set(self.fenwick, self.order1[p] as usize, self.rank[p] + 1);
+                while let Some(&lp) = l.get(next_l).filter(|&&lp| self.v(lp, 0) >= x0) {
+                    let p = lp as usize;
+                    if let (Some(&o), Some(&r)) = (self.order1.get(p), self.rank.get(p)) {
+                        fenwick_set(self.fenwick, o as usize, r + 1);
+                    }
                     next_l += 1;
                 }
             }
             // In one lexicographic list every earlier solution has objective 0 `>=`.
-            let at = self.order1[hh as usize] as usize;
+            let (Some(&at), Some(r)) =
+                (self.order1.get(hh as usize), self.rank.get_mut(hh as usize))
+            else {
+                continue;
+            };
+            let at = at as usize;
             let best = fenwick_max(self.fenwick, at + 1);
-            if best > self.rank[hh as usize] {
-                self.rank[hh as usize] = best;
+            if best > *r {
+                *r = best;
             }
             if same {
-                fenwick_set(self.fenwick, at, self.rank[hh as usize] + 1);
+                let r = *r;
+                fenwick_set(self.fenwick, at, r + 1);
             }
         }
-        let inserted = if same { h } else { &l[..next_l] };
+        let inserted = if same {
+            h
+        } else {
+            l.get(..next_l).unwrap_or(l)
+        };
         for &p in inserted {
-            fenwick_clear(self.fenwick, self.order1[p as usize] as usize);
+            if let Some(&o) = self.order1.get(p as usize) {
+                fenwick_clear(self.fenwick, o as usize);
+            }
         }
     }
 
@@ -286,10 +312,23 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
         let take = if n <= 64 { n } else { 15 };
         for t in 0..take {
             let i = t * n / take;
-            let p = if i < a.len() { a[i] } else { b[i - a.len()] };
-            self.scratch[t] = ordered_bits(self.v(p, o));
+            let p = match a.get(i) {
+                Some(&p) => p,
+                None => b.get(i - a.len()).copied().unwrap_or(0),
+            };
+            let x = ordered_bits(self.v(p, o));
+            if let Some(slot) = self.scratch.get_mut(t) {
+                *slot = x;
+            }
         }
-        let (_, &mut m, _) = self.scratch[..take].select_nth_unstable(take / 2);
+        let mid = take / 2;
+        let m = match self.scratch.get_mut(..take) {
+            Some(sc) => {
+                crate::sort::select_nth_unstable(sc, mid);
+                sc.get(mid).copied().unwrap_or(0)
+            }
+            None => 0,
+        };
         let m = from_ordered_bits(m);
         (m, mx <= m)
     }
@@ -300,30 +339,51 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
         let mut w = 0usize;
         let mut c = 0usize;
         for i in 0..s.len() {
-            let x = self.v(s[i], o);
+            let si = s[i];
+            let x = self.v(si, o);
             if x > p || (ge && x >= p) {
-                s[w] = s[i];
+                // w <= i
+                if let Some(d) = s.get_mut(w) {
+                    *d = si;
+                }
                 w += 1;
             } else {
-                self.scratch[c] = s[i];
+                if let Some(d) = self.scratch.get_mut(c) {
+                    *d = si;
+                }
                 c += 1;
             }
         }
-        s[w..].copy_from_slice(&self.scratch[..c]);
+        // w + c == s.len()
+        if let (Some(d), Some(src)) = (s.get_mut(w..), self.scratch.get(..c)) {
+            if d.len() == src.len() {
+                d.copy_from_slice(src);
+            }
+        }
         w
     }
 
     /// Merges the ascending runs `s[..mid]` and `s[mid..]`.
     fn merge(&mut self, s: &mut [u32], mid: usize) {
-        self.scratch[..mid].copy_from_slice(&s[..mid]);
+        let (Some(dst), Some(src)) = (self.scratch.get_mut(..mid), s.get(..mid)) else {
+            return;
+        };
+        dst.copy_from_slice(src);
         let (mut i, mut j, mut o) = (0usize, mid, 0usize);
-        while i < mid {
-            if j < s.len() && s[j] < self.scratch[i] {
-                s[o] = s[j];
-                j += 1;
-            } else {
-                s[o] = self.scratch[i];
-                i += 1;
+        while let Some(&x) = self.scratch.get(i).filter(|_| i < mid) {
+            let v = match s.get(j) {
+                Some(&y) if y < x => {
+                    j += 1;
+                    y
+                }
+                _ => {
+                    i += 1;
+                    x
+                }
+            };
+            // o < j <= s.len()
+            if let Some(d) = s.get_mut(o) {
+                *d = v;
             }
             o += 1;
         }
@@ -336,8 +396,8 @@ fn fenwick_max(t: &[u32], q: usize) -> u32 {
     let mut i = q.min(t.len());
     let mut m = 0u32;
     while i > 0 {
-        if t[i - 1] > m {
-            m = t[i - 1];
+        if let Some(&x) = t.get(i - 1) {
+            m = m.max(x);
         }
         i &= i - 1;
     }
@@ -364,9 +424,12 @@ fn from_ordered_bits(b: u32) -> f32 {
 /// Zeroes the entries [`fenwick_set`] touched for index `at`.
 #[inline]
 fn fenwick_clear(t: &mut [u32], at: usize) {
-    let mut i = at + 1;
+    let mut i = at.saturating_add(1);
+    // i >= 1 and strictly increasing
     while i <= t.len() {
-        t[i - 1] = 0;
+        if let Some(x) = t.get_mut(i - 1) {
+            *x = 0;
+        }
         i += i & i.wrapping_neg();
     }
 }
@@ -374,10 +437,13 @@ fn fenwick_clear(t: &mut [u32], at: usize) {
 /// Raises entry `at` of a Fenwick prefix-maximum tree to at least `v`.
 #[inline]
 fn fenwick_set(t: &mut [u32], at: usize, v: u32) {
-    let mut i = at + 1;
+    let mut i = at.saturating_add(1);
+    // i >= 1 and strictly increasing
     while i <= t.len() {
-        if t[i - 1] < v {
-            t[i - 1] = v;
+        if let Some(x) = t.get_mut(i - 1) {
+            if *x < v {
+                *x = v;
+            }
         }
         i += i & i.wrapping_neg();
     }

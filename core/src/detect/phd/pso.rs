@@ -24,6 +24,7 @@
 use super::ndsort;
 use crate::math;
 use crate::rng::Rng;
+use crate::sort;
 
 const NONE: u32 = u32::MAX;
 
@@ -47,6 +48,16 @@ pub fn dominates(a: &[f32], b: &[f32]) -> bool {
         strict |= x > y;
     }
     strict
+}
+
+/// `a[to] = a[from]` (nothing when either is out of range: never, for the callers).
+#[inline(always)]
+fn shift<T: Copy>(a: &mut [T], from: usize, to: usize) {
+    if let Some(&v) = a.get(from) {
+        if let Some(d) = a.get_mut(to) {
+            *d = v;
+        }
+    }
 }
 
 /// Lexicographic "better first" order on objective vectors (descending).
@@ -86,11 +97,18 @@ pub fn non_dominated_sort<const M: usize>(
     for (i, o) in order[..n].iter_mut().enumerate() {
         *o = i as u32;
     }
-    order[..n].sort_unstable_by(|&a, &b| {
-        lex_desc(&f[a as usize][..m], &f[b as usize][..m]).then(a.cmp(&b))
+    sort::sort_unstable_by(&mut order[..n], |&a, &b| {
+        match (f.get(a as usize), f.get(b as usize)) {
+            (Some(fa), Some(fb)) => lex_desc(&fa[..m], &fb[..m]),
+            _ => core::cmp::Ordering::Equal,
+        }
+        .then(a.cmp(&b))
     });
     ens_bs(&order[..n], m <= 2, rank, next, head, |a, b| {
-        dominates(&f[a][..m], &f[b][..m])
+        match (f.get(a), f.get(b)) {
+            (Some(fa), Some(fb)) => dominates(&fa[..m], &fb[..m]),
+            _ => false,
+        }
     })
 }
 
@@ -115,7 +133,7 @@ fn ens_bs(
         let s = s as usize;
         // Is s dominated by some member of front `j`?
         let dominated_by = |j: usize, head: &[u32], next: &[u32]| {
-            let mut t = head[j];
+            let mut t = head.get(j).copied().unwrap_or(NONE);
             while t != NONE {
                 if dom(t as usize, s) {
                     return true;
@@ -123,7 +141,7 @@ fn ens_bs(
                 if newest_only {
                     return false;
                 }
-                t = next[t as usize];
+                t = next.get(t as usize).copied().unwrap_or(NONE);
             }
             false
         };
@@ -138,12 +156,18 @@ fn ens_bs(
             }
         }
         if lo == fronts {
-            head[fronts] = NONE;
+            if let Some(h) = head.get_mut(fronts) {
+                *h = NONE;
+            }
             fronts += 1;
         }
-        next[s] = head[lo];
-        head[lo] = s as u32;
-        rank[s] = lo as u32;
+        if let (Some(h), Some(nx)) = (head.get_mut(lo), next.get_mut(s)) {
+            *nx = *h;
+            *h = s as u32;
+        }
+        if let Some(r) = rank.get_mut(s) {
+            *r = lo as u32;
+        }
     }
     fronts
 }
@@ -172,31 +196,56 @@ pub fn crowding_distance<const M: usize>(
         for (i, o) in order[..n].iter_mut().enumerate() {
             *o = i as u32;
         }
-        order[..n].sort_unstable_by(|&a, &b| {
-            rank[a as usize].cmp(&rank[b as usize]).then(
-                f[a as usize][j]
-                    .partial_cmp(&f[b as usize][j])
-                    .unwrap_or(core::cmp::Ordering::Equal),
+        // (front, f_j), ties by index: a total order, so the result is defined.
+        let key = |i: u32| {
+            let i = i as usize;
+            (
+                rank.get(i).copied(),
+                f.get(i).and_then(|r| r.get(j)).copied().unwrap_or(0.0),
             )
+        };
+        sort::sort_unstable_by(&mut order[..n], |&a, &b| {
+            let ((ra, fa), (rb, fb)) = (key(a), key(b));
+            ra.cmp(&rb)
+                .then(fa.partial_cmp(&fb).unwrap_or(core::cmp::Ordering::Equal))
+                .then(a.cmp(&b))
         });
+        let fj = |i: u32| {
+            f.get(i as usize)
+                .and_then(|r| r.get(j))
+                .copied()
+                .unwrap_or(0.0)
+        };
+        let rk = |i: u32| rank.get(i as usize).copied();
+        let order = &order[..n];
+        let wj = weights.get(j).copied().unwrap_or(0.0);
+        // One front's members are the run order[s..e] of equal rank.
         let mut s = 0usize;
-        while s < n {
-            let r = rank[order[s] as usize];
-            let mut e = s;
-            while e < n && rank[order[e] as usize] == r {
+        while let Some(&first) = order.get(s) {
+            let r = rk(first);
+            let mut e = s + 1;
+            while order.get(e).is_some_and(|&o| rk(o) == r) {
                 e += 1;
             }
-            let lo = f[order[s] as usize][j];
-            let hi = f[order[e - 1] as usize][j];
-            let span = hi - lo;
+            let Some(front) = order.get(s..e) else {
+                break;
+            };
+            let (Some(&a), Some(&b)) = (front.first(), front.last()) else {
+                break;
+            };
+            let span = fj(b) - fj(a);
             if span > 0.0 {
-                crowd[order[s] as usize] = boundary;
-                crowd[order[e - 1] as usize] = boundary;
-                for k in s + 1..e.saturating_sub(1) {
-                    let i = order[k] as usize;
-                    if crowd[i] < boundary {
-                        let d = f[order[k + 1] as usize][j] - f[order[k - 1] as usize][j];
-                        crowd[i] += weights[j] * d / span;
+                for i in [a, b] {
+                    if let Some(c) = crowd.get_mut(i as usize) {
+                        *c = boundary;
+                    }
+                }
+                for w in front.windows(3) {
+                    let (prev, i, next) = (w[0], w[1], w[2]);
+                    if let Some(c) = crowd.get_mut(i as usize) {
+                        if *c < boundary {
+                            *c += wj * (fj(next) - fj(prev)) / span;
+                        }
                     }
                 }
             }
@@ -303,6 +352,8 @@ pub struct Swarm<const S: usize, const M: usize> {
     next: [u32; S],
     head: [u32; S],
     aux: [u32; S],
+    /// Sort keys `key << 32 | index` (a `u64` sort needs no lookups in the comparator).
+    keys: [u64; S],
     kept: [bool; S],
     /// A group's active objectives by sorted position, for the divide-and-conquer sort
     /// (one contiguous load per value instead of two dependent ones: -7 % instructions
@@ -345,6 +396,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             next: [0; S],
             head: [0; S],
             aux: [0; S],
+            keys: [0; S],
             kept: [false; S],
             objs: [[0.0; DC_OBJECTIVES]; S],
             len: 0,
@@ -387,22 +439,29 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     /// (below the gate): far points then tie exactly, so each particle has only the few
     /// objectives of the points near it, and no `exp` is spent on the others.
     fn evaluate(&mut self, i: usize, points: &[[f32; 2]], inv_two_s2: f32, cut: f32) -> f32 {
-        let p = self.pos[i];
+        let (Some(&p), Some(fit), Some(best_fit), Some(best)) = (
+            self.pos.get(i),
+            self.fit.get_mut(i),
+            self.pbest_fit.get_mut(i),
+            self.pbest.get_mut(i),
+        ) else {
+            return 0.0;
+        };
         let mut total = 0.0;
-        for (m, z) in points.iter().enumerate().take(M) {
+        for (f, z) in fit.iter_mut().zip(points) {
             let dx = p[0] - z[0];
             let dy = p[1] - z[1];
             let a = (dx * dx + dy * dy) * inv_two_s2;
             let v = if a > cut { 0.0 } else { math::exp(-a) };
-            self.fit[i][m] = v;
+            *f = v;
             total += v;
         }
         if !points.is_empty() {
             total /= points.len().min(M) as f32;
         }
-        if total > self.pbest_fit[i] {
-            self.pbest_fit[i] = total;
-            self.pbest[i] = p;
+        if total > *best_fit {
+            *best_fit = total;
+            *best = p;
         }
         total
     }
@@ -411,7 +470,10 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     #[inline]
     pub fn best_objective(&self, i: usize, m: usize) -> (usize, f32) {
         let mut best = (0usize, f32::NEG_INFINITY);
-        for (j, &v) in self.fit[i][..m.min(M)].iter().enumerate() {
+        let Some(fit) = self.fit.get(i) else {
+            return best;
+        };
+        for (j, &v) in fit[..m.min(M)].iter().enumerate() {
             if v > best.1 {
                 best = (j, v);
             }
@@ -430,7 +492,8 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     /// objective is `j`) is the parent with the largest `f_j` (ties: larger eq. 19 total,
     /// then lower index), which is always on the first front.
     pub fn run(&mut self, cfg: &PsoConfig, points: &[[f32; 2]], rng: &mut Rng) -> SwarmReport {
-        let n = self.len;
+        // `push` keeps `len <= S / 2`; `len` is public.
+        let n = self.len.min(S / 2);
         let m = points.len().min(M);
         if n == 0 || m == 0 {
             return SwarmReport::default();
@@ -469,7 +532,14 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             ];
             for i in 0..n {
                 let c = n + i;
-                let g = self.pos[leader[self.best_objective(i, m).0]];
+                if c >= S {
+                    break;
+                }
+                let g = leader
+                    .get(self.best_objective(i, m).0)
+                    .and_then(|&l| self.pos.get(l))
+                    .copied()
+                    .unwrap_or(self.pos[i]);
                 let mut v = [0.0f32; 2];
                 let mut x = [0.0f32; 2];
                 for d in 0..2 {
@@ -504,19 +574,20 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             // Compact the kept entries in ascending index order (safe forward copy).
             let mut k = 0usize;
             mean_best = 0.0;
-            for s in 0..2 * n {
+            for s in 0..(2 * n).min(S) {
                 if !self.kept[s] {
                     continue;
                 }
-                if k != s {
-                    self.pos[k] = self.pos[s];
-                    self.vel[k] = self.vel[s];
-                    self.pbest[k] = self.pbest[s];
-                    self.pbest_fit[k] = self.pbest_fit[s];
-                    self.fit[k] = self.fit[s];
-                    self.weight[k] = self.weight[s];
-                    self.src[k] = self.src[s];
-                    self.group[k] = self.group[s];
+                // k <= s
+                if k < s {
+                    shift(&mut self.pos, s, k);
+                    shift(&mut self.vel, s, k);
+                    shift(&mut self.pbest, s, k);
+                    shift(&mut self.pbest_fit, s, k);
+                    shift(&mut self.fit, s, k);
+                    shift(&mut self.weight, s, k);
+                    shift(&mut self.src, s, k);
+                    shift(&mut self.group, s, k);
                 }
                 mean_best += self.best_objective(k, m).1;
                 k += 1;
@@ -547,10 +618,12 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     /// ENS-BS checking every front member. Only the front that is cut gets
     /// crowding distances (NSGA-II), since the fronts before it are kept whole.
     fn select(&mut self, tot: usize, m: usize, obj_w: f32) {
+        let tot = tot.min(S);
+        let m = m.min(M);
         // Counting sort of the entries by group into `order`.
         let mut start = [0usize; M];
-        for i in 0..tot {
-            start[(self.group[i] as usize).min(M - 1)] += 1;
+        for &g in self.group.iter().take(tot) {
+            start[(g as usize).min(M - 1)] += 1;
         }
         let mut acc = 0usize;
         for c in start.iter_mut() {
@@ -563,10 +636,12 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
         let mut active = [[false; M]; M];
         for i in 0..tot {
             let g = (self.group[i] as usize).min(M - 1);
-            self.order[end[g]] = i as u32;
+            if let Some(o) = self.order.get_mut(end[g]) {
+                *o = i as u32;
+            }
             end[g] += 1;
             self.kept[i] = false;
-            for (a, &v) in active[g][..m].iter_mut().zip(&self.fit[i][..m]) {
+            for (a, &v) in active[g].iter_mut().zip(&self.fit[i]).take(m) {
                 *a |= v > 0.0;
             }
         }
@@ -587,53 +662,78 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             }
             for j in 0..m {
                 if active[g][j] && !(na > 0 && act[0] == j) {
-                    act[na] = j;
+                    if let Some(a) = act.get_mut(na) {
+                        *a = j;
+                    }
                     na += 1;
                 }
             }
-            let act = &act[..na];
+            let act = act.get(..na).unwrap_or(&act);
             let fit = &self.fit;
-            if na <= 1 {
+            let value = |i: u32, j: usize| {
+                fit.get(i as usize)
+                    .and_then(|r| r.get(j))
+                    .copied()
+                    .unwrap_or(0.0)
+            };
+            let Some(members) = self.order.get_mut(s..e) else {
+                continue;
+            };
+            let Some(keys) = self.keys.get_mut(..members.len()) else {
+                continue;
+            };
+            // Descending by the first active objective, ties by index: `u64` keys
+            // `!bits(f) << 32 | i` (`bits` orders like the values; fitness is never NaN
+            // or -0 for finite positions).
+            let first = |i: u32| act.first().map_or(0.0, |&j| value(i, j));
+            for (k, &i) in keys.iter_mut().zip(members.iter()) {
+                *k = (u64::from(!ndsort::ordered_bits(first(i))) << 32) | u64::from(i);
+            }
+            let Some(rest) = act.get(1..).filter(|_| na > 1) else {
                 // Fronts are the distinct values of the one objective, best first.
-                let key = |i: u32| {
-                    if na == 1 {
-                        fit[i as usize][act[0]]
-                    } else {
-                        0.0
+                sort::select_nth_unstable(keys, keep - 1);
+                for &k in keys.iter().take(keep) {
+                    if let Some(kept) = self.kept.get_mut(k as u32 as usize) {
+                        *kept = true;
                     }
-                };
-                self.order[s..e].select_nth_unstable_by(keep - 1, |&a, &b| {
-                    key(b)
-                        .partial_cmp(&key(a))
-                        .unwrap_or(core::cmp::Ordering::Equal)
-                        .then(a.cmp(&b))
-                });
-                for &i in &self.order[s..s + keep] {
-                    self.kept[i as usize] = true;
                 }
                 continue;
+            };
+            // Lexicographically descending on the active objectives, ties by index: by
+            // the first objective's keys, then the runs of equal first objective by the
+            // others.
+            sort::sort_unstable(keys);
+            for (m, &k) in members.iter_mut().zip(keys.iter()) {
+                *m = k as u32;
             }
-            // Lexicographically descending on the active objectives, ties by index; the
-            // first objective as a precomputed key.
-            let j0 = act[0];
-            for &i in &self.order[s..e] {
-                self.aux[i as usize] = !ndsort::ordered_bits(fit[i as usize][j0]);
+            let mut a = 0usize;
+            while let Some(&ka) = keys.get(a) {
+                let mut b = a + 1;
+                while keys.get(b).is_some_and(|&kb| kb >> 32 == ka >> 32) {
+                    b += 1;
+                }
+                if let Some(run) = members.get_mut(a..b).filter(|r| r.len() > 1) {
+                    sort::sort_unstable_by(run, |&x, &y| {
+                        let (Some(fx), Some(fy)) = (fit.get(x as usize), fit.get(y as usize))
+                        else {
+                            return x.cmp(&y);
+                        };
+                        for &j in rest {
+                            let (Some(&u), Some(&v)) = (fx.get(j), fy.get(j)) else {
+                                break;
+                            };
+                            if u > v {
+                                return core::cmp::Ordering::Less;
+                            }
+                            if u < v {
+                                return core::cmp::Ordering::Greater;
+                            }
+                        }
+                        x.cmp(&y)
+                    });
+                }
+                a = b;
             }
-            let key = &self.aux;
-            self.order[s..e].sort_unstable_by(|&a, &b| {
-                key[a as usize].cmp(&key[b as usize]).then_with(|| {
-                    let (fa, fb) = (&fit[a as usize], &fit[b as usize]);
-                    for &j in &act[1..] {
-                        if fa[j] > fb[j] {
-                            return core::cmp::Ordering::Less;
-                        }
-                        if fa[j] < fb[j] {
-                            return core::cmp::Ordering::Greater;
-                        }
-                    }
-                    a.cmp(&b)
-                })
-            });
             // Two objectives: ENS-BS checking one member per front; three or four: the
             // divide-and-conquer sort; five or more: ENS-BS with full front checks (the
             // divide-and-conquer's `log^(M-1) N` factor outgrows it at these group
@@ -656,49 +756,66 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     /// returns (kept, members of the cut front).
     fn fronts_ens(&mut self, s: usize, e: usize, keep: usize, act: &[usize]) -> (usize, usize) {
         let fit = &self.fit;
+        let (Some(order), Some(head)) = (self.order.get(s..e), self.head.get_mut(s..e)) else {
+            return (0, 0);
+        };
         let fronts = ens_bs(
-            &self.order[s..e],
+            order,
             act.len() <= 2,
             &mut self.rank,
             &mut self.next,
-            &mut self.head[s..e],
+            head,
             |a, b| {
-                let (fa, fb) = (&fit[a], &fit[b]);
+                let (Some(fa), Some(fb)) = (fit.get(a), fit.get(b)) else {
+                    return false;
+                };
                 let mut strict = false;
                 for &j in act {
-                    if fa[j] < fb[j] {
+                    let (Some(&x), Some(&y)) = (fa.get(j), fb.get(j)) else {
+                        return false;
+                    };
+                    if x < y {
                         return false;
                     }
-                    strict |= fa[j] > fb[j];
+                    strict |= x > y;
                 }
                 strict
             },
         );
+        let next = &self.next;
+        let after = |t: u32| next.get(t as usize).copied().unwrap_or(NONE);
         let mut taken = 0usize;
         for fr in 0..fronts {
+            let Some(&first) = head.get(fr) else {
+                break;
+            };
             let mut cnt = 0usize;
-            let mut t = self.head[s + fr];
+            let mut t = first;
             while t != NONE {
                 cnt += 1;
-                t = self.next[t as usize];
+                t = after(t);
             }
-            let mut t = self.head[s + fr];
+            let mut t = first;
             if taken + cnt <= keep {
                 while t != NONE {
-                    self.kept[t as usize] = true;
-                    t = self.next[t as usize];
+                    if let Some(k) = self.kept.get_mut(t as usize) {
+                        *k = true;
+                    }
+                    t = after(t);
                 }
                 taken += cnt;
                 if taken == keep {
                     return (taken, 0);
                 }
             } else {
-                // `head[s + fr]` was read: `head[s..]` is free for the members.
+                // `head[fr]` was read: `head[..]` is free for the members.
                 let mut c = 0usize;
                 while t != NONE {
-                    self.head[s + c] = t;
+                    if let Some(h) = head.get_mut(c) {
+                        *h = t;
+                    }
                     c += 1;
-                    t = self.next[t as usize];
+                    t = after(t);
                 }
                 return (taken, c);
             }
@@ -711,37 +828,58 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     /// ranks in `rank[s..e]`, workspaces `head`, `next`, `aux`, `crowd` over `s..e`), then
     /// as [`Swarm::fronts_ens`].
     fn fronts_many(&mut self, s: usize, e: usize, keep: usize, act: &[usize]) -> (usize, usize) {
-        let len = e - s;
-        for (o, &i) in self.objs.iter_mut().zip(&self.order[s..e]) {
-            let f = &self.fit[i as usize];
+        let (Some(order), Some(rank), Some(head), Some(next), Some(aux), Some(crowd)) = (
+            self.order.get(s..e),
+            self.rank.get_mut(s..e),
+            self.head.get_mut(s..e),
+            self.next.get_mut(s..e),
+            self.aux.get_mut(s..e),
+            self.crowd.get_mut(s..e),
+        ) else {
+            return (0, 0);
+        };
+        for (o, &i) in self.objs.iter_mut().zip(order) {
+            let Some(f) = self.fit.get(i as usize) else {
+                continue;
+            };
             for (v, &j) in o.iter_mut().zip(act) {
-                *v = f[j];
+                *v = f.get(j).copied().unwrap_or(0.0);
             }
         }
         let objs = &self.objs;
         let fronts = ndsort::rank_sorted(
-            len,
+            order.len(),
             act.len().min(DC_OBJECTIVES),
-            |p, j| objs[p][j],
-            &mut self.rank[s..e],
+            // j < DC_OBJECTIVES: `% DC_OBJECTIVES` only shows the optimiser the bound
+            |p, j| objs.get(p).map_or(0.0, |r| r[j % DC_OBJECTIVES]),
+            rank,
             ndsort::Workspace {
-                work: &mut self.head[s..e],
-                scratch: &mut self.next[s..e],
-                order1: &mut self.aux[s..e],
-                fenwick: &mut self.crowd[s..e],
+                work: head,
+                scratch: next,
+                order1: aux,
+                fenwick: crowd,
             },
         );
+        // The workspaces again (the borrows ended with the call).
+        let (Some(rank), Some(head), Some(count)) = (
+            self.rank.get(s..e),
+            self.head.get_mut(s..e),
+            self.next.get_mut(s..e),
+        ) else {
+            return (0, 0);
+        };
         // Front sizes (fronts <= len), then the front that is cut.
-        let count = &mut self.next[s..e];
-        for c in count[..fronts].iter_mut() {
+        for c in count.iter_mut().take(fronts) {
             *c = 0;
         }
-        for &r in &self.rank[s..e] {
-            count[r as usize] += 1;
+        for &r in rank {
+            if let Some(c) = count.get_mut(r as usize) {
+                *c += 1;
+            }
         }
         let mut taken = 0usize;
         let mut cut = fronts;
-        for (fr, &c) in count[..fronts].iter().enumerate() {
+        for (fr, &c) in count.iter().take(fronts).enumerate() {
             if taken + c as usize > keep {
                 cut = fr;
                 break;
@@ -754,13 +892,16 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
         }
         let collect = taken < keep;
         let mut c = 0usize;
-        for p in 0..len {
-            let r = self.rank[s + p] as usize;
-            let i = self.order[s + p];
+        for (&r, &i) in rank.iter().zip(order) {
+            let r = r as usize;
             if r < cut {
-                self.kept[i as usize] = true;
+                if let Some(k) = self.kept.get_mut(i as usize) {
+                    *k = true;
+                }
             } else if collect && r == cut {
-                self.head[s + c] = i;
+                if let Some(h) = head.get_mut(c) {
+                    *h = i;
+                }
                 c += 1;
             }
         }
@@ -772,44 +913,70 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     /// (ties: lower index).
     fn crowd_cut(&mut self, s: usize, len: usize, need: usize, act: &[usize], obj_w: f32) {
         let fit = &self.fit;
-        let members = &mut self.head[s..s + len];
+        let Some(members) = self.head.get_mut(s..s + len) else {
+            return;
+        };
         for &i in members.iter() {
-            self.crowd[i as usize] = 0;
+            if let Some(c) = self.crowd.get_mut(i as usize) {
+                *c = 0;
+            }
         }
         let boundary = f32::MAX.to_bits();
         for &j in act {
             // Ascending by `f_j`, ties by index.
-            for &i in members.iter() {
-                self.aux[i as usize] = ndsort::ordered_bits(fit[i as usize][j]);
+            let fj = |i: u32| {
+                fit.get(i as usize)
+                    .and_then(|r| r.get(j))
+                    .copied()
+                    .unwrap_or(0.0)
+            };
+            let Some(keys) = self.keys.get_mut(..members.len()) else {
+                return;
+            };
+            for (k, &i) in keys.iter_mut().zip(members.iter()) {
+                *k = (u64::from(ndsort::ordered_bits(fj(i))) << 32) | u64::from(i);
             }
-            let key = &self.aux;
-            members
-                .sort_unstable_by(|&a, &b| key[a as usize].cmp(&key[b as usize]).then(a.cmp(&b)));
-            let lo = fit[members[0] as usize][j];
-            let hi = fit[members[len - 1] as usize][j];
-            let span = hi - lo;
+            sort::sort_unstable(keys);
+            for (m, &k) in members.iter_mut().zip(keys.iter()) {
+                *m = k as u32;
+            }
+            let (Some(&lo), Some(&hi)) = (members.first(), members.last()) else {
+                continue;
+            };
+            let span = fj(hi) - fj(lo);
             if span > 0.0 {
-                self.crowd[members[0] as usize] = boundary;
-                self.crowd[members[len - 1] as usize] = boundary;
-                for k in 1..len.saturating_sub(1) {
-                    let i = members[k] as usize;
-                    if self.crowd[i] < boundary {
-                        let d = fit[members[k + 1] as usize][j] - fit[members[k - 1] as usize][j];
-                        let c = f32::from_bits(self.crowd[i]) + obj_w * d / span;
-                        self.crowd[i] = c.to_bits();
+                for i in [lo, hi] {
+                    if let Some(c) = self.crowd.get_mut(i as usize) {
+                        *c = boundary;
+                    }
+                }
+                for w in members.windows(3) {
+                    let (prev, i, next) = (w[0], w[1], w[2]);
+                    if let Some(c) = self.crowd.get_mut(i as usize) {
+                        if *c < boundary {
+                            let d = fj(next) - fj(prev);
+                            *c = (f32::from_bits(*c) + obj_w * d / span).to_bits();
+                        }
                     }
                 }
             }
         }
-        let crowd = &self.crowd;
         if need == 0 || need > len {
             return;
         }
-        members.select_nth_unstable_by(need - 1, |&a, &b| {
-            crowd[b as usize].cmp(&crowd[a as usize]).then(a.cmp(&b))
-        });
-        for &i in &members[..need] {
-            self.kept[i as usize] = true;
+        // Most isolated first, ties by index: keys `!crowd << 32 | i`.
+        let Some(keys) = self.keys.get_mut(..members.len()) else {
+            return;
+        };
+        for (k, &i) in keys.iter_mut().zip(members.iter()) {
+            let c = self.crowd.get(i as usize).copied().unwrap_or(0);
+            *k = (u64::from(!c) << 32) | u64::from(i);
+        }
+        sort::select_nth_unstable(keys, need - 1);
+        for &k in keys.iter().take(need) {
+            if let Some(kept) = self.kept.get_mut(k as u32 as usize) {
+                *kept = true;
+            }
         }
     }
 }

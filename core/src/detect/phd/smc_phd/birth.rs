@@ -85,8 +85,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         let wb = b.mass / j as f32;
         let nc = b.n_components;
         let mut k = self.n;
-        for ci in 0..nc {
-            let comp = b.components[ci];
+        for (ci, &comp) in b.components.iter().enumerate().take(nc) {
             let count = j / nc + usize::from(ci < j % nc);
             // Measurement-driven: strongest cells of the component's window on the
             // *previous* frame, propagated one step (`choose_birth_cells`).
@@ -107,8 +106,12 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                 0
             };
             for _ in 0..count {
-                let s = if nb > 0 {
-                    let (idx, _) = cells[self.rng.below(nb as u32) as usize];
+                let pick = if nb > 0 {
+                    cells.get(self.rng.below(nb as u32) as usize).copied()
+                } else {
+                    None
+                };
+                let s = if let Some((idx, _)) = pick {
                     let (ir, jd, lb) = g.unindex(idx);
                     let r = g.range_start + (ir as f32 + self.rng.uniform()) * g.range_cell;
                     let d = g.doppler_start + (jd as f32 + self.rng.uniform()) * g.doppler_cell;
@@ -118,7 +121,9 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                     let (sb, cb) = (math::sin(az), math::cos(az));
                     let mut vt = tang * self.rng.normal();
                     for _ in 0..np.min(4) {
-                        let (pidx, _) = prev[self.rng.below(np as u32) as usize];
+                        let Some(&(pidx, _)) = prev.get(self.rng.below(np as u32) as usize) else {
+                            break;
+                        };
                         let (pr, _, pl) = g.unindex(pidx);
                         let r2 = g.range_start + (pr as f32 + self.rng.uniform()) * g.range_cell;
                         let a2 = (g.azimuth_start_deg
@@ -144,9 +149,12 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                     s
                 };
                 let inten = self.rng.uniform_range(b.intensity[0], b.intensity[1]);
-                self.x[k] = [s[0], s[1], s[2], s[3], inten.max(self.cfg.min_intensity)];
-                self.w[k] = wb;
-                k += 1;
+                // k < n + j <= N
+                if let (Some(x), Some(w)) = (self.x.get_mut(k), self.w.get_mut(k)) {
+                    *x = [s[0], s[1], s[2], s[3], inten.max(self.cfg.min_intensity)];
+                    *w = wb;
+                    k += 1;
+                }
             }
         }
         self.n = k;
@@ -228,8 +236,8 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         let mut az = [AxisWeights::NONE; AZ_CACHE];
         let cached = b1.saturating_sub(b0) <= AZ_CACHE;
         if cached {
-            for lb in b0..b1 {
-                az[lb - b0] = psf.axis_weights(frac(0, 0, lb).2, g.n_azimuth, psf.loss_azimuth);
+            for (w, lb) in az.iter_mut().zip(b0..b1) {
+                *w = psf.axis_weights(frac(0, 0, lb).2, g.n_azimuth, psf.loss_azimuth);
             }
         }
         for ir in r0..r1 {

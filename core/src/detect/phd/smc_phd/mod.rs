@@ -224,7 +224,7 @@ pub struct PhdReport {
 /// swarm entries (parents plus children, so up to `S / 2` particles move), `M`
 /// measurement points (PSO objectives), `K` extracted targets.
 ///
-/// Memory: about `123 N + (56 + 4 M) S` bytes (32-bit target; e.g. 864 KB at
+/// Memory: about `123 N + (64 + 4 M) S` bytes (32-bit target; e.g. 897 KB at
 /// `N = S = 4096, M = 8`): build large instances in a `Box`, or zeroed in a `static` and
 /// set up by [`Detector::configure`].
 #[derive(Debug, Clone)]
@@ -314,17 +314,20 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
 
     /// Extracted states of the last frame.
     pub fn estimates(&self) -> &[Estimate] {
-        &self.est[..self.n_est]
+        self.est.get(..self.n_est).unwrap_or(&[])
     }
 
     /// Current particles `[x, vx, y, vy, I]` and their weights.
     pub fn particles(&self) -> (&[[f32; 5]], &[f32]) {
-        (&self.x[..self.n], &self.w[..self.n])
+        match (self.x.get(..self.n), self.w.get(..self.n)) {
+            (Some(x), Some(w)) => (x, w),
+            _ => (&[], &[]),
+        }
     }
 
     /// Measurement-derived points of the last PSO step.
     pub fn measurement_points(&self) -> &[[f32; 2]] {
-        &self.zpts[..self.n_z]
+        self.zpts.get(..self.n_z).unwrap_or(&[])
     }
 
     /// One power cube (the [`Detector::step`]; `geometry.len()` cells, layout of
@@ -394,8 +397,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         let b = if a > 0.0 { q * t * t / 2.0 / a } else { 0.0 };
         let cc = math::sqrt((q * t - b * b).max(0.0));
         let si = math::sqrt(c.q_intensity * t);
-        for i in 0..self.n {
-            let s = &mut self.x[i];
+        for (s, w) in self.x.iter_mut().zip(self.w.iter_mut()).take(self.n) {
             for k in [0usize, 2] {
                 let n1 = self.rng.normal();
                 let n2 = self.rng.normal();
@@ -403,7 +405,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                 s[k + 1] += b * n1 + cc * n2;
             }
             s[4] = (s[4] + si * self.rng.normal()).max(c.min_intensity);
-            self.w[i] *= c.p_survival;
+            *w *= c.p_survival;
         }
     }
 }

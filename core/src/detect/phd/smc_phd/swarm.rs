@@ -15,8 +15,11 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         let mut amp = [0.0f32; M];
         let mut nt = 0usize;
         let mut last_cell = usize::MAX;
-        for i in 0..n_surv {
-            let s = self.x[i];
+        if want == 0 {
+            self.n_z = 0;
+            return;
+        }
+        for &s in self.x.iter().take(n_surv) {
             let c = RadarCoords::from_state(s[0], s[1], s[2], s[3]);
             let Some((ir, jd, lb)) = g.cell_of(&c) else {
                 continue;
@@ -40,7 +43,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                     z += h * h * v;
                 }
             });
-            if nt == want && z <= top[nt - 1].0 {
+            if nt == want && top.get(nt.wrapping_sub(1)).is_some_and(|t| z <= t.0) {
                 continue;
             }
             // Thinning in range, azimuth *and* Doppler: targets born at the same place
@@ -50,15 +53,18 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             let near = |e: &(f32, usize, usize, usize)| {
                 e.1.abs_diff(ir) <= 1 && e.2.abs_diff(lb) <= 1 && e.3.abs_diff(jd) <= 1
             };
-            if top[..nt].iter().any(|e| near(e) && e.0 >= z) {
+            if top.iter().take(nt).any(|e| near(e) && e.0 >= z) {
                 continue;
             }
             // Drop weaker neighbours, then insert.
             let mut k = 0;
-            for t in 0..nt {
+            for t in 0..nt.min(M) {
                 if !near(&top[t]) {
-                    top[k] = top[t];
-                    amp[k] = amp[t];
+                    // k <= t
+                    if k < t {
+                        top[k] = top[t];
+                        amp[k] = amp[t];
+                    }
                     k += 1;
                 }
             }
@@ -67,16 +73,26 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             if nt < want {
                 nt += 1;
             }
-            while p > 0 && top[p - 1].0 < z {
-                top[p] = top[p - 1];
-                amp[p] = amp[p - 1];
+            // p < want <= M
+            while p > 0 {
+                let (Some(&tp), Some(&ap)) = (top.get(p - 1), amp.get(p - 1)) else {
+                    break;
+                };
+                if tp.0.partial_cmp(&z) != Some(core::cmp::Ordering::Less) {
+                    break;
+                }
+                if let (Some(t), Some(a)) = (top.get_mut(p), amp.get_mut(p)) {
+                    (*t, *a) = (tp, ap);
+                }
                 p -= 1;
             }
-            top[p] = (z, ir, lb, jd);
-            amp[p] = math::sqrt(s[4].max(0.0));
+            let a = math::sqrt(s[4].max(0.0));
+            if let (Some(t), Some(am)) = (top.get_mut(p), amp.get_mut(p)) {
+                (*t, *am) = ((z, ir, lb, jd), a);
+            }
         }
         let refine = self.cfg.pso.is_some_and(|p| p.refine_points);
-        for (k, e) in top[..nt].iter().enumerate() {
+        for (k, e) in top.iter().enumerate().take(nt) {
             let (x, y) = if refine {
                 self.refine_point(cube, e.1, e.3, e.2, amp[k])
             } else {
@@ -132,10 +148,11 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
 
     /// The swarm over at most `pso.max_members` of the gated particles.
     pub(super) fn swarm_step(&mut self, pso: &PsoConfig) -> (usize, usize) {
-        let m = self.n_z;
+        let m = self.n_z.min(M);
         if m == 0 {
             return (0, 0);
         }
+        let zpts = &self.zpts[..m];
         let inv = 1.0 / (2.0 * pso.fitness_scale * pso.fitness_scale);
         let nearest = |p: [f32; 2], z: &[[f32; 2]]| {
             let mut best = (0usize, f32::INFINITY);
@@ -151,12 +168,13 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         self.swarm.clear();
         // The gated particles (index in `order`, nearest point in `key`).
         let mut gated = 0usize;
-        for i in 0..self.n {
-            let p = [self.x[i][0], self.x[i][2]];
-            let (k, d) = nearest(p, &self.zpts[..m]);
+        for (i, x) in self.x.iter().enumerate().take(self.n) {
+            let (k, d) = nearest([x[0], x[2]], zpts);
             if math::exp(-d * inv) >= pso.gate {
-                self.order[gated] = i as u32;
-                self.key[gated] = k as u32;
+                // gated <= i
+                if let (Some(o), Some(kk)) = (self.order.get_mut(gated), self.key.get_mut(gated)) {
+                    (*o, *kk) = (i as u32, k as u32);
+                }
                 gated += 1;
             }
         }
@@ -167,24 +185,36 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         let mut n_s = 0usize;
         for j in 0..take {
             let g = (j as u64 * gated as u64 / take as u64) as usize;
-            let (i, k) = (self.order[g] as usize, self.key[g] as usize);
-            let p = [self.x[i][0], self.x[i][2]];
-            if !self.swarm.push(p, self.w[i], i as u32, k as u16) {
+            let (Some(&i), Some(&k)) = (self.order.get(g), self.key.get(g)) else {
+                break;
+            };
+            let (i, k) = (i as usize, k as usize);
+            let (Some(x), Some(&w)) = (self.x.get(i), self.w.get(i)) else {
+                break;
+            };
+            if !self.swarm.push([x[0], x[2]], w, i as u32, k as u16) {
                 break;
             }
             // `g >= j`: slot `j` of `order` is free once read.
-            self.order[n_s] = i as u32;
-            before[k] += self.w[i];
+            if let Some(o) = self.order.get_mut(n_s) {
+                *o = i as u32;
+            }
+            if let Some(b) = before.get_mut(k) {
+                *b += w;
+            }
             n_s += 1;
         }
         if n_s == 0 {
             return (0, 0);
         }
-        let rep = self.swarm.run(pso, &self.zpts[..m], &mut self.rng);
+        let rep = self.swarm.run(pso, zpts, &mut self.rng);
+        let n_s = n_s.min(S);
         let mut after = [0.0f32; M];
         for k in 0..n_s {
-            let (g, _) = nearest(self.swarm.pos[k], &self.zpts[..m]);
-            after[g] += self.swarm.weight[k];
+            let (g, _) = nearest(self.swarm.pos[k], zpts);
+            if let Some(a) = after.get_mut(g) {
+                *a += self.swarm.weight[k];
+            }
         }
 
         let mut scale = [1.0f32; M];
@@ -195,17 +225,21 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         }
         for k in 0..n_s {
             let src = self.swarm.src[k] as usize;
-            let mut s = self.x[src];
+            let mut s = self.x.get(src).copied().unwrap_or_default();
             s[0] = self.swarm.pos[k][0];
             s[2] = self.swarm.pos[k][1];
-            self.scratch[k] = s;
-            let (g, _) = nearest(self.swarm.pos[k], &self.zpts[..m]);
-            self.lw[k] = self.swarm.weight[k] * scale[g];
+            let (g, _) = nearest(self.swarm.pos[k], zpts);
+            let w = self.swarm.weight[k] * scale.get(g).copied().unwrap_or(1.0);
+            if let (Some(sc), Some(lw)) = (self.scratch.get_mut(k), self.lw.get_mut(k)) {
+                (*sc, *lw) = (s, w);
+            }
         }
-        for k in 0..n_s {
-            let slot = self.order[k] as usize;
-            self.x[slot] = self.scratch[k];
-            self.w[slot] = self.lw[k];
+        for ((&slot, &s), &w) in self.order.iter().zip(&self.scratch).zip(&self.lw).take(n_s) {
+            if let (Some(x), Some(wt)) =
+                (self.x.get_mut(slot as usize), self.w.get_mut(slot as usize))
+            {
+                (*x, *wt) = (s, w);
+            }
         }
         (n_s, rep.generations)
     }

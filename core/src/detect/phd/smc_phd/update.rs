@@ -22,9 +22,15 @@ const NEIGHBOURS: [(i64, i64, i64); 13] = [
 ];
 
 /// Union-find root with path halving.
+/// (An index out of range is its own root: never, for the callers.)
 fn find(parent: &mut [u32], mut r: usize) -> usize {
-    while parent[r] as usize != r {
-        let gp = parent[parent[r] as usize];
+    while let Some(&p) = parent.get(r) {
+        if p as usize == r {
+            break;
+        }
+        let Some(&gp) = parent.get(p as usize) else {
+            break;
+        };
         parent[r] = gp;
         r = gp as usize;
     }
@@ -37,7 +43,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         let g = *cube.geometry();
         let psf = self.cfg.psf;
         let s2 = self.cfg.noise_var;
-        let n = self.n;
+        let n = self.n.min(N);
         for i in 0..n {
             let s = self.x[i];
             let c = RadarCoords::from_state(s[0], s[1], s[2], s[3]);
@@ -64,26 +70,35 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         }
         {
             let key = &self.key;
-            self.order[..n].sort_unstable_by_key(|&i| (key[i as usize], i));
+            crate::sort::sort_unstable_by_key(&mut self.order[..n], |&i| {
+                (key.get(i as usize).copied().unwrap_or(u32::MAX), i)
+            });
         }
         let ln_lambda = math::ln(self.cfg.clutter_lambda);
         // Runs of equal cell; `run_of[i]` for every particle (u32::MAX outside).
         let mut nr = 0usize;
         let mut s = 0usize;
-        while s < n {
-            let k = self.key[self.order[s] as usize];
+        let order = &self.order[..n];
+        let key = &self.key;
+        let cell = |o: u32| key.get(o as usize).copied().unwrap_or(u32::MAX);
+        while let Some(&first) = order.get(s) {
+            let k = cell(first);
             let mut e = s;
-            while e < n && self.key[self.order[e] as usize] == k {
-                self.anc[self.order[e] as usize] = if k == u32::MAX { u32::MAX } else { nr as u32 };
+            while let Some(&o) = order.get(e).filter(|&&o| cell(o) == k) {
+                if let Some(a) = self.anc.get_mut(o as usize) {
+                    *a = if k == u32::MAX { u32::MAX } else { nr as u32 };
+                }
                 e += 1;
             }
             if k != u32::MAX {
-                self.run_key[nr] = k;
-                self.parent[nr] = nr as u32;
+                if let (Some(rk), Some(p)) = (self.run_key.get_mut(nr), self.parent.get_mut(nr)) {
+                    (*rk, *p) = (k, nr as u32);
+                }
                 nr += 1;
             }
-            s = e;
+            s = e.max(s + 1);
         }
+        let nr = nr.min(N);
         // Merge runs whose cells touch (|d| <= 1 on every axis): one target's energy
         // spreads over neighbouring cells, and particles attributed to either are one
         // "resolution cell" for the normalisation of eq. 20 (else every neighbour cell
@@ -107,7 +122,9 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                         let (ra, rb) = (find(&mut self.parent, r), find(&mut self.parent, q));
                         if ra != rb {
                             let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-                            self.parent[hi] = lo as u32;
+                            if let Some(p) = self.parent.get_mut(hi) {
+                                *p = lo as u32;
+                            }
                         }
                     }
                 }
@@ -122,13 +139,16 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             if r != u32::MAX {
                 let root = find(&mut self.parent, r as usize);
                 self.anc[i] = root as u32;
-                self.pts[root][0] = self.pts[root][0].max(self.lw[i]);
+                if let Some(p) = self.pts.get_mut(root) {
+                    p[0] = p[0].max(self.lw[i]);
+                }
             }
         }
         for i in 0..n {
-            let r = self.anc[i];
-            if r != u32::MAX && self.pts[r as usize][0] > f32::NEG_INFINITY {
-                self.pts[r as usize][1] += math::exp(self.lw[i] - self.pts[r as usize][0]);
+            if let Some(p) = self.pts.get_mut(self.anc[i] as usize) {
+                if p[0] > f32::NEG_INFINITY {
+                    p[1] += math::exp(self.lw[i] - p[0]);
+                }
             }
         }
         for r in 0..nr {
@@ -140,10 +160,11 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         let mut total = KahanSum::new();
         for i in 0..n {
             let r = self.anc[i];
-            let wi = if r == u32::MAX || self.lw[i] == f32::NEG_INFINITY {
-                0.0
-            } else {
-                math::exp(self.lw[i] - self.pts[r as usize][1])
+            let wi = match self.pts.get(r as usize) {
+                Some(p) if r != u32::MAX && self.lw[i] != f32::NEG_INFINITY => {
+                    math::exp(self.lw[i] - p[1])
+                }
+                _ => 0.0,
             };
             self.w[i] = wi;
             total.add(wi);
@@ -162,22 +183,22 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         if l == 0 || self.n == 0 {
             return false;
         }
-        if resample(
-            Scheme::Systematic,
-            &self.w[..self.n],
-            &mut self.anc[..l],
-            &mut self.rng,
-        )
-        .is_err()
-        {
+        let (Some(w), Some(anc)) = (self.w.get(..self.n), self.anc.get_mut(..l)) else {
+            return false;
+        };
+        if resample(Scheme::Systematic, w, anc, &mut self.rng).is_err() {
             return false;
         }
-        for j in 0..l {
-            self.scratch[j] = self.x[self.anc[j] as usize];
+        for (sc, &a) in self.scratch.iter_mut().zip(&*anc) {
+            *sc = self.x.get(a as usize).copied().unwrap_or_default();
         }
-        self.x[..l].copy_from_slice(&self.scratch[..l]);
+        let l = anc.len();
+        let (Some(x), Some(sc)) = (self.x.get_mut(..l), self.scratch.get(..l)) else {
+            return false;
+        };
+        x.copy_from_slice(sc);
         let wl = mass / l as f32;
-        for w in self.w[..l].iter_mut() {
+        for w in self.w.iter_mut().take(l) {
             *w = wl;
         }
         self.n = l;
@@ -186,7 +207,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
 
     pub(super) fn extract(&mut self, n_hat: usize) -> Result<()> {
         self.n_est = 0;
-        let n = self.n;
+        let n = self.n.min(N);
         if n_hat == 0 || n == 0 {
             return Ok(());
         }
@@ -206,7 +227,10 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                     }
                     let mut acc = [0.0f32; 5];
                     for &m in members {
-                        for (a, v) in acc.iter_mut().zip(&x[m as usize]) {
+                        let Some(xm) = x.get(m as usize) else {
+                            continue;
+                        };
+                        for (a, v) in acc.iter_mut().zip(xm) {
                             *a += v;
                         }
                     }
@@ -233,21 +257,22 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                 let mut acc = [[0.0f32; 5]; K];
                 for i in 0..n {
                     let c = self.kmeans.assign[i] as usize;
-                    if c < k {
-                        for (a, v) in acc[c].iter_mut().zip(&self.x[i]) {
+                    if let Some(a) = acc.get_mut(c).filter(|_| c < k) {
+                        for (a, v) in a.iter_mut().zip(&self.x[i]) {
                             *a += v;
                         }
                     }
                 }
-                for c in 0..k {
-                    let cnt = self.kmeans.counts[c];
+                for (&cnt, a) in self.kmeans.counts.iter().zip(&acc).take(k) {
                     if cnt > 0 {
                         let inv = 1.0 / cnt as f32;
-                        self.est[self.n_est] = Estimate {
-                            state: acc[c].map(|a| a * inv),
-                            support: cnt,
-                        };
-                        self.n_est += 1;
+                        if let Some(e) = self.est.get_mut(self.n_est) {
+                            *e = Estimate {
+                                state: a.map(|a| a * inv),
+                                support: cnt,
+                            };
+                            self.n_est += 1;
+                        }
                     }
                 }
             }
