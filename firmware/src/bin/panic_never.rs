@@ -15,10 +15,13 @@
 #![no_std]
 #![no_main]
 
+#[path = "../panic_never_common.rs"]
+#[macro_use]
+mod common;
+
 use core::hint::black_box;
 
 use cortex_m_rt::entry;
-use cortex_m_semihosting::{debug, hio};
 use faint_core::detect::cbmember::{CbmemberConfig, CbmemberTbd, Likelihood};
 use faint_core::detect::Detector;
 use faint_core::existence::ExistenceMarkov;
@@ -32,28 +35,18 @@ const N: usize = 1000;
 /// CBMeMBer TBD on a 32 x 128 map (16-bin blocks: 256 block sums).
 type Cbm = CbmemberTbd<2, 64, 256>;
 type CbmU8 = CbmemberTbd<2, 64, 256, [u8]>;
-// SAFETY: const-evaluated all-zero value (an invalid zero field is a compile error);
-// `configure` sets it up before use.
-static mut CBM: Cbm = unsafe { core::mem::MaybeUninit::zeroed().assume_init() };
-static mut CBM_U8: CbmU8 = unsafe { core::mem::MaybeUninit::zeroed().assume_init() };
+zeroed!(CBM: Cbm);
+zeroed!(CBM_U8: CbmU8);
 static mut MAP: [f32; 32 * 128] = [0.0; 32 * 128];
 static mut MAP_U8: [u8; 32 * 128] = [0; 32 * 128];
 
 #[entry]
 fn main() -> ! {
-    let ok = run();
-    say(if ok {
-        b"panic-never: primitives and CbmemberTbd linked without a panic path and ran ok\n"
-    } else {
-        b"panic-never: a primitive returned Err\n"
-    });
-    debug::exit(if ok {
-        debug::EXIT_SUCCESS
-    } else {
-        debug::EXIT_FAILURE
-    });
-    #[allow(clippy::empty_loop)]
-    loop {}
+    common::finish(
+        run(),
+        b"panic-never: primitives and CbmemberTbd linked without a panic path and ran ok\n",
+        b"panic-never: a primitive returned Err\n",
+    )
 }
 
 fn run() -> bool {
@@ -194,20 +187,4 @@ fn cbmember(rng: &mut Rng) -> bool {
     ok &= det.configure(&bad, 1).is_err();
     black_box(score);
     ok
-}
-
-fn say(msg: &[u8]) {
-    if let Ok(mut out) = hio::hstdout() {
-        let _ = out.write_all(msg);
-    }
-}
-
-#[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
-    extern "Rust" {
-        // Deliberately undefined: referencing it is the link error.
-        fn faint_core_panic_path_survived() -> !;
-    }
-    // SAFETY: never linked; a successful link proves this call is unreachable.
-    unsafe { faint_core_panic_path_survived() }
 }

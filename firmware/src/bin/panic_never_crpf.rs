@@ -20,11 +20,13 @@
 #![no_std]
 #![no_main]
 
+#[path = "../panic_never_common.rs"]
+#[macro_use]
+mod common;
+
 use core::hint::black_box;
-use core::mem::MaybeUninit;
 
 use cortex_m_rt::entry;
-use cortex_m_semihosting::{debug, hio};
 use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd, Weighting};
 use faint_core::detect::pf_lrt::PfLrt;
@@ -43,15 +45,6 @@ const M: usize = 32;
 /// `sum w_n^2` of the 32-point window, about 12.1).
 const BIN_VAR: f32 = 12.1;
 
-/// An all-zero `static` detector: the const evaluator rejects (compile error) a zero bit
-/// pattern that is not a valid value of every field; `configure` sets it up.
-macro_rules! zeroed {
-    ($name:ident: $t:ty) => {
-        // SAFETY: validity of the all-zero value is checked by const evaluation.
-        static mut $name: $t = unsafe { MaybeUninit::zeroed().assume_init() };
-    };
-}
-
 zeroed!(CRPF_64: CrpfTbd<64>);
 zeroed!(PF_64: PfTbd<64>);
 zeroed!(JOTT_64: BernoulliTbd<64>);
@@ -68,28 +61,11 @@ zeroed!(CACHE: ProjectionCache);
 
 #[entry]
 fn main() -> ! {
-    let ok = run();
-    say(if ok {
-        b"panic-never-crpf: CRPF-TBD, PF-TBD, JOTT and PF-LRT linked without a panic path and ran ok\n"
-    } else {
-        b"panic-never-crpf: a call did not return the expected Ok or Err\n"
-    });
-    debug::exit(if ok {
-        debug::EXIT_SUCCESS
-    } else {
-        debug::EXIT_FAILURE
-    });
-    #[allow(clippy::empty_loop)]
-    loop {}
-}
-
-/// The `&mut` to a static.
-///
-/// # Safety
-/// `p` points to a static that nothing else references while the result lives.
-unsafe fn only_ref<T>(p: *mut T) -> &'static mut T {
-    // SAFETY: the caller's contract.
-    unsafe { &mut *p }
+    common::finish(
+        run(),
+        b"panic-never-crpf: CRPF-TBD, PF-TBD, JOTT and PF-LRT linked without a panic path and ran ok\n",
+        b"panic-never-crpf: a call did not return the expected Ok or Err\n",
+    )
 }
 
 fn run() -> bool {
@@ -100,24 +76,24 @@ fn run() -> bool {
     // to its static.
     unsafe {
         ok &= family::<64>(
-            only_ref(&raw mut CRPF_64),
-            only_ref(&raw mut PF_64),
-            only_ref(&raw mut JOTT_64),
-            only_ref(&raw mut LRT_64),
+            common::only_ref(&raw mut CRPF_64),
+            common::only_ref(&raw mut PF_64),
+            common::only_ref(&raw mut JOTT_64),
+            common::only_ref(&raw mut LRT_64),
             &mut rng,
         );
         ok &= family::<1000>(
-            only_ref(&raw mut CRPF_1000),
-            only_ref(&raw mut PF_1000),
-            only_ref(&raw mut JOTT_1000),
-            only_ref(&raw mut LRT_1000),
+            common::only_ref(&raw mut CRPF_1000),
+            common::only_ref(&raw mut PF_1000),
+            common::only_ref(&raw mut JOTT_1000),
+            common::only_ref(&raw mut LRT_1000),
             &mut rng,
         );
         ok &= family::<6000>(
-            only_ref(&raw mut CRPF_6000),
-            only_ref(&raw mut PF_6000),
-            only_ref(&raw mut JOTT_6000),
-            only_ref(&raw mut LRT_6000),
+            common::only_ref(&raw mut CRPF_6000),
+            common::only_ref(&raw mut PF_6000),
+            common::only_ref(&raw mut JOTT_6000),
+            common::only_ref(&raw mut LRT_6000),
             &mut rng,
         );
     }
@@ -458,7 +434,7 @@ fn model_functions(rng: &mut Rng) -> bool {
     acc += w.iter().map(|c| c.re + c.im).sum::<f32>();
 
     // SAFETY: single-threaded, the only reference to this static.
-    let cache = unsafe { only_ref(&raw mut CACHE) };
+    let cache = unsafe { common::only_ref(&raw mut CACHE) };
     let sizes = black_box([SPAN, 7, 31, M, 33, MAX_BINS, SPAN - 1, MAX_BINS + 1]);
     let windows = black_box([Window::Hamming, Window::Rectangular, Window::Hann]);
     for (i, &bins) in sizes.iter().enumerate() {
@@ -521,20 +497,4 @@ fn model_functions(rng: &mut Rng) -> bool {
     ok &= GaussConfig::othr(black_box(f32::NAN)).validate().is_err();
     black_box(acc);
     ok
-}
-
-fn say(msg: &[u8]) {
-    if let Ok(mut out) = hio::hstdout() {
-        let _ = out.write_all(msg);
-    }
-}
-
-#[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
-    extern "Rust" {
-        // Deliberately undefined: referencing it is the link error.
-        fn faint_core_panic_path_survived() -> !;
-    }
-    // SAFETY: never linked; a successful link proves this call is unreachable.
-    unsafe { faint_core_panic_path_survived() }
 }

@@ -16,10 +16,13 @@
 #![no_std]
 #![no_main]
 
+#[path = "../panic_never_common.rs"]
+#[macro_use]
+mod common;
+
 use core::hint::black_box;
 
 use cortex_m_rt::entry;
-use cortex_m_semihosting::{debug, hio};
 use faint_core::detect::dp::{
     arnold_words, pulford_words, second_order_words, ArnoldDp, DpConfig, DpTrack, Method,
     PulfordDp, SecondOrderDp, Transition,
@@ -48,19 +51,11 @@ static mut S25_DET: S25 = S25::unconfigured();
 
 #[entry]
 fn main() -> ! {
-    let ok = run();
-    say(if ok {
-        b"panic-never-dp: DP-TBD detectors linked without a panic path and ran ok\n"
-    } else {
-        b"panic-never-dp: a call did not return the expected Ok or Err\n"
-    });
-    debug::exit(if ok {
-        debug::EXIT_SUCCESS
-    } else {
-        debug::EXIT_FAILURE
-    });
-    #[allow(clippy::empty_loop)]
-    loop {}
+    common::finish(
+        run(),
+        b"panic-never-dp: DP-TBD detectors linked without a panic path and ran ok\n",
+        b"panic-never-dp: a call did not return the expected Ok or Err\n",
+    )
 }
 
 fn run() -> bool {
@@ -179,20 +174,4 @@ fn exercise<D: DpTrack>(det: &mut D, cfg: &DpConfig, rng: &mut Rng, z: &mut [f32
     ok &= det.step(black_box(&z[..])).is_ok();
     black_box(acc);
     ok
-}
-
-fn say(msg: &[u8]) {
-    if let Ok(mut out) = hio::hstdout() {
-        let _ = out.write_all(msg);
-    }
-}
-
-#[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
-    extern "Rust" {
-        // Deliberately undefined: referencing it is the link error.
-        fn faint_core_panic_path_survived() -> !;
-    }
-    // SAFETY: never linked; a successful link proves this call is unreachable.
-    unsafe { faint_core_panic_path_survived() }
 }

@@ -20,11 +20,13 @@
 #![no_std]
 #![no_main]
 
+#[path = "../panic_never_common.rs"]
+#[macro_use]
+mod common;
+
 use core::hint::black_box;
-use core::mem::MaybeUninit;
 
 use cortex_m_rt::entry;
-use cortex_m_semihosting::{debug, hio};
 use faint_core::detect::mht::censoring::Censor;
 use faint_core::detect::mht::dmht::{recover, Assoc};
 use faint_core::detect::mht::{
@@ -46,15 +48,6 @@ type ClassicSmall = ClassicHough<32, 30, 4>;
 /// Plot buffer: more than the largest capacity, for the overflow scan.
 const BUF: usize = 600;
 
-/// An all-zero `static`: the const evaluator rejects (compile error) a zero bit pattern
-/// that is not a valid value of every field; `configure` sets it up.
-macro_rules! zeroed {
-    ($name:ident: $t:ty) => {
-        // SAFETY: validity of the all-zero value is checked by const evaluation.
-        static mut $name: $t = unsafe { MaybeUninit::zeroed().assume_init() };
-    };
-}
-
 static mut BIG: Big = Big::unconfigured();
 static mut SMALL: Small = Small::unconfigured();
 zeroed!(CLASSIC_BIG: ClassicBig);
@@ -66,28 +59,11 @@ static mut PLOTS: [Plot; BUF] = [Plot::new(0.0, 0.0, 0.0); BUF];
 
 #[entry]
 fn main() -> ! {
-    let ok = run();
-    say(if ok {
-        b"panic-never-mht: MHT-TBD and the classic Hough TBD linked without a panic path and ran ok\n"
-    } else {
-        b"panic-never-mht: a call did not return the expected Ok or Err\n"
-    });
-    debug::exit(if ok {
-        debug::EXIT_SUCCESS
-    } else {
-        debug::EXIT_FAILURE
-    });
-    #[allow(clippy::empty_loop)]
-    loop {}
-}
-
-/// The `&mut` to a static.
-///
-/// # Safety
-/// `p` points to a static that nothing else references while the result lives.
-unsafe fn only_ref<T>(p: *mut T) -> &'static mut T {
-    // SAFETY: the caller's contract.
-    unsafe { &mut *p }
+    common::finish(
+        run(),
+        b"panic-never-mht: MHT-TBD and the classic Hough TBD linked without a panic path and ran ok\n",
+        b"panic-never-mht: a call did not return the expected Ok or Err\n",
+    )
 }
 
 fn run() -> bool {
@@ -97,14 +73,14 @@ fn run() -> bool {
     // to its static.
     let (big, small, cbig, csmall, acc, censor, flags, buf) = unsafe {
         (
-            only_ref(&raw mut BIG),
-            only_ref(&raw mut SMALL),
-            only_ref(&raw mut CLASSIC_BIG),
-            only_ref(&raw mut CLASSIC_SMALL),
-            only_ref(&raw mut ACC),
-            only_ref(&raw mut CENSOR),
-            only_ref(&raw mut FLAGS),
-            only_ref(&raw mut PLOTS),
+            common::only_ref(&raw mut BIG),
+            common::only_ref(&raw mut SMALL),
+            common::only_ref(&raw mut CLASSIC_BIG),
+            common::only_ref(&raw mut CLASSIC_SMALL),
+            common::only_ref(&raw mut ACC),
+            common::only_ref(&raw mut CENSOR),
+            common::only_ref(&raw mut FLAGS),
+            common::only_ref(&raw mut PLOTS),
         )
     };
     ok &= mht(big, &mut rng, buf);
@@ -620,20 +596,4 @@ fn censoring<const P: usize>(
     }
     black_box(sum);
     true
-}
-
-fn say(msg: &[u8]) {
-    if let Ok(mut out) = hio::hstdout() {
-        let _ = out.write_all(msg);
-    }
-}
-
-#[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
-    extern "Rust" {
-        // Deliberately undefined: referencing it is the link error.
-        fn faint_core_panic_path_survived() -> !;
-    }
-    // SAFETY: never linked; a successful link proves this call is unreachable.
-    unsafe { faint_core_panic_path_survived() }
 }

@@ -21,11 +21,13 @@
 #![no_std]
 #![no_main]
 
+#[path = "../panic_never_common.rs"]
+#[macro_use]
+mod common;
+
 use core::hint::black_box;
-use core::mem::MaybeUninit;
 
 use cortex_m_rt::entry;
-use cortex_m_semihosting::{debug, hio};
 use faint_core::detect::phd::dbscan::{Dbscan, DbscanParams};
 use faint_core::detect::phd::kmeans::KMeans;
 use faint_core::detect::phd::ndsort::{rank_sorted, Workspace};
@@ -46,15 +48,6 @@ type Tiny = SmcPhdTbd<64, 16, 1, 1>;
 /// Cube buffer: one cell more than the firmware window, for the long frame.
 const CELLS: usize = 32 * 32 * 32 + 1;
 
-/// An all-zero `static`: the const evaluator rejects (compile error) a zero bit pattern
-/// that is not a valid value of every field; `configure` sets it up.
-macro_rules! zeroed {
-    ($name:ident: $t:ty) => {
-        // SAFETY: validity of the all-zero value is checked by const evaluation.
-        static mut $name: $t = unsafe { MaybeUninit::zeroed().assume_init() };
-    };
-}
-
 zeroed!(BIG: Big);
 zeroed!(SMALL: Small);
 zeroed!(TINY: Tiny);
@@ -65,28 +58,11 @@ static mut CUBE: [f32; CELLS] = [0.0; CELLS];
 
 #[entry]
 fn main() -> ! {
-    let ok = run();
-    say(if ok {
-        b"panic-never-phd: PHD-TBD, PSO-PHD-TBD (K-means) and PSO-PHD-TBD (DBSCAN) linked without a panic path and ran ok\n"
-    } else {
-        b"panic-never-phd: a call did not return the expected Ok or Err\n"
-    });
-    debug::exit(if ok {
-        debug::EXIT_SUCCESS
-    } else {
-        debug::EXIT_FAILURE
-    });
-    #[allow(clippy::empty_loop)]
-    loop {}
-}
-
-/// The `&mut` to a static.
-///
-/// # Safety
-/// `p` points to a static that nothing else references while the result lives.
-unsafe fn only_ref<T>(p: *mut T) -> &'static mut T {
-    // SAFETY: the caller's contract.
-    unsafe { &mut *p }
+    common::finish(
+        run(),
+        b"panic-never-phd: PHD-TBD, PSO-PHD-TBD (K-means) and PSO-PHD-TBD (DBSCAN) linked without a panic path and ran ok\n",
+        b"panic-never-phd: a call did not return the expected Ok or Err\n",
+    )
 }
 
 fn run() -> bool {
@@ -96,13 +72,13 @@ fn run() -> bool {
     // to its static.
     let (big, small, tiny, swarm, dbscan, kmeans, buf) = unsafe {
         (
-            only_ref(&raw mut BIG),
-            only_ref(&raw mut SMALL),
-            only_ref(&raw mut TINY),
-            only_ref(&raw mut SWARM),
-            only_ref(&raw mut DBSCAN),
-            only_ref(&raw mut KMEANS),
-            only_ref(&raw mut CUBE),
+            common::only_ref(&raw mut BIG),
+            common::only_ref(&raw mut SMALL),
+            common::only_ref(&raw mut TINY),
+            common::only_ref(&raw mut SWARM),
+            common::only_ref(&raw mut DBSCAN),
+            common::only_ref(&raw mut KMEANS),
+            common::only_ref(&raw mut CUBE),
         )
     };
     // The firmware's shape and counts on its window: two scene frames per variant (the
@@ -389,20 +365,4 @@ fn helpers(
     ok &= kmeans.run(pts.get(..n).unwrap_or(&[]), 3, 20, rng).is_err();
     black_box(members);
     ok
-}
-
-fn say(msg: &[u8]) {
-    if let Ok(mut out) = hio::hstdout() {
-        let _ = out.write_all(msg);
-    }
-}
-
-#[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
-    extern "Rust" {
-        // Deliberately undefined: referencing it is the link error.
-        fn faint_core_panic_path_survived() -> !;
-    }
-    // SAFETY: never linked; a successful link proves this call is unreachable.
-    unsafe { faint_core_panic_path_survived() }
 }
