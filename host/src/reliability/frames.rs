@@ -4,6 +4,8 @@
 //! sometimes with a strong return), the rest carry arbitrary bits, extremes, a constant,
 //! a single NaN/inf, or the wrong length.
 
+use faint_core::detect::cbmember::CbmemberConfig;
+use faint_core::detect::phd::PhdConfig;
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
 use faint_core::Complex32;
@@ -185,4 +187,35 @@ pub fn plots(rng: &mut Rng, area: [f32; 4], capacity: usize, mode: Mode) -> Vec<
             v
         }
     }
+}
+
+/// The frame length `n`, or a short frame of 16 when `n` overflowed or exceeds `max` (a
+/// configuration asking for more than a generator draws gets short frames).
+pub fn len_or_short(n: Option<usize>, max: usize) -> usize {
+    match n {
+        Some(n) if n <= max => n,
+        _ => 16,
+    }
+}
+
+/// A power cube for a PHD-family configuration: `range x doppler x azimuth` cells.
+pub fn cube(rng: &mut Rng, c: &PhdConfig, mode: Mode, max: usize) -> Vec<f32> {
+    let g = c.geometry;
+    let n = g
+        .n_range
+        .checked_mul(g.n_doppler)
+        .and_then(|x| x.checked_mul(g.n_azimuth));
+    reals(rng, len_or_short(n, max), mode, 1.0, true)
+}
+
+/// A range-velocity map for a CBMeMBer configuration.
+pub fn map(rng: &mut Rng, c: &CbmemberConfig, mode: Mode, max: usize) -> Vec<f32> {
+    let g = c.geometry;
+    reals(
+        rng,
+        len_or_short(g.n_range.checked_mul(g.n_velocity), max),
+        mode,
+        1.0,
+        true,
+    )
 }

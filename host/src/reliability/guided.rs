@@ -55,7 +55,7 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 use serde_value::Value as Tree;
 
-use super::frames::{complex, plots, reals, Mode, BAD, EXTREMES};
+use super::frames::{self, complex, len_or_short, plots, reals, Mode, BAD, EXTREMES};
 use super::mutate::{FLOATS, INTS};
 use super::{check_outputs, outputs, twin_check, Kind};
 use crate::reproduce::mht::{Classic, Mht, P as MHT_PLOTS};
@@ -545,15 +545,8 @@ pub type Second25 = Second<25, { second_order_words(DP_SIDE, 25, DP_HISTORY) }>;
 /// Largest frame a generator draws (a configuration asking for more gets short frames).
 const MAX_FRAME: usize = 1 << 16;
 
-fn len_or_short(n: Option<usize>) -> usize {
-    match n {
-        Some(n) if n <= MAX_FRAME => n,
-        _ => 16,
-    }
-}
-
 fn doppler<C>(bins: fn(&C) -> usize) -> impl Fn(&mut Rng, &C, Mode) -> Vec<Complex32> {
-    move |rng, c, mode| complex(rng, len_or_short(Some(bins(c))), mode, 1.0)
+    move |rng, c, mode| complex(rng, len_or_short(Some(bins(c)), MAX_FRAME), mode, 1.0)
 }
 
 fn crpf_frame(rng: &mut Rng, c: &CrpfConfig, mode: Mode) -> Vec<Complex32> {
@@ -573,18 +566,11 @@ fn classic_frame(rng: &mut Rng, c: &ClassicHoughConfig, mode: Mode) -> Vec<Plot>
 }
 
 fn phd_frame(rng: &mut Rng, c: &PhdConfig, mode: Mode) -> Vec<f32> {
-    let g = c.geometry;
-    let n = g
-        .n_range
-        .checked_mul(g.n_doppler)
-        .and_then(|x| x.checked_mul(g.n_azimuth));
-    reals(rng, len_or_short(n), mode, 1.0, true)
+    frames::cube(rng, c, mode, MAX_FRAME)
 }
 
 fn cbm_frame(rng: &mut Rng, c: &CbmemberConfig, mode: Mode) -> Vec<f32> {
-    let g = c.geometry;
-    let n = len_or_short(g.n_range.checked_mul(g.n_velocity));
-    reals(rng, n, mode, 1.0, true)
+    frames::map(rng, c, mode, MAX_FRAME)
 }
 
 fn dp_frame(rng: &mut Rng, _c: &DpConfig, mode: Mode) -> Vec<f32> {

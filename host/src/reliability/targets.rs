@@ -25,7 +25,7 @@ use faint_core::rng::Rng;
 use serde::Serialize;
 use serde_json::Value;
 
-use super::frames::{complex, plots, reals, Mode};
+use super::frames::{self, complex, len_or_short, plots, reals, Mode};
 use super::soak::{soak, Shape, Soak, WorkCounters};
 use super::{fuzz, Options, Tally, Target};
 use crate::detect::default_classic;
@@ -51,19 +51,12 @@ fn to_value<C: Serialize>(c: &C) -> Value {
     serde_json::to_value(c).unwrap_or(Value::Null)
 }
 
-fn len_or_short(n: Option<usize>) -> usize {
-    match n {
-        Some(n) if n <= MAX_FRAME => n,
-        _ => 16,
-    }
-}
-
 fn doppler_crpf(rng: &mut Rng, c: &CrpfConfig, mode: Mode) -> Vec<faint_core::Complex32> {
-    complex(rng, len_or_short(Some(c.model.bins)), mode, 1.0)
+    complex(rng, len_or_short(Some(c.model.bins), MAX_FRAME), mode, 1.0)
 }
 
 fn doppler_gauss(rng: &mut Rng, c: &GaussConfig, mode: Mode) -> Vec<faint_core::Complex32> {
-    complex(rng, len_or_short(Some(c.model.bins)), mode, 1.0)
+    complex(rng, len_or_short(Some(c.model.bins), MAX_FRAME), mode, 1.0)
 }
 
 fn scan_mht(rng: &mut Rng, c: &MhtConfig, mode: Mode) -> Vec<faint_core::model::plot::Plot> {
@@ -79,23 +72,11 @@ fn scan_classic(
 }
 
 fn cube(rng: &mut Rng, c: &PhdConfig, mode: Mode) -> Vec<f32> {
-    let g = c.geometry;
-    let n = g
-        .n_range
-        .checked_mul(g.n_doppler)
-        .and_then(|x| x.checked_mul(g.n_azimuth));
-    reals(rng, len_or_short(n), mode, 1.0, true)
+    frames::cube(rng, c, mode, MAX_FRAME)
 }
 
 fn map(rng: &mut Rng, c: &CbmemberConfig, mode: Mode) -> Vec<f32> {
-    let g = c.geometry;
-    reals(
-        rng,
-        len_or_short(g.n_range.checked_mul(g.n_velocity)),
-        mode,
-        1.0,
-        true,
-    )
+    frames::map(rng, c, mode, MAX_FRAME)
 }
 
 fn image(rng: &mut Rng, _c: &DpConfig, mode: Mode) -> Vec<f32> {
