@@ -57,6 +57,8 @@ fn exact_is_the_preset_and_bad_shares_are_typed_errors() {
         Ok(Some(9))
     );
     assert_eq!(BirthProposal::Exact.birth_count::<1>(), Ok(None));
+    // What the option adds to every Gaussian comparator's configuration.
+    assert_eq!(std::mem::size_of::<BirthProposal>(), 8);
     let bad_share = Error::InvalidConfig("birth proposal share must be finite and in (0, 1)");
     for s in [0.0, 1.0, -0.1, 1.5, f32::NAN, f32::INFINITY] {
         let b = BirthProposal::FixedShare(s);
@@ -84,8 +86,14 @@ fn exact_is_the_preset_and_bad_shares_are_typed_errors() {
     // Deterministic: the same seed gives the same bits, for both detectors.
     let again = existence(&mut PfTbd::<200>::new(cfg(v, SHARE), 3).unwrap(), &run);
     assert_eq!(again, want);
-    let j1 = existence(&mut BernoulliTbd::<200>::new(cfg(v, SHARE), 3).unwrap(), &run);
-    let j2 = existence(&mut BernoulliTbd::<200>::new(cfg(v, SHARE), 3).unwrap(), &run);
+    let j1 = existence(
+        &mut BernoulliTbd::<200>::new(cfg(v, SHARE), 3).unwrap(),
+        &run,
+    );
+    let j2 = existence(
+        &mut BernoulliTbd::<200>::new(cfg(v, SHARE), 3).unwrap(),
+        &run,
+    );
     assert_eq!(j1, j2);
 }
 
@@ -113,7 +121,10 @@ fn without_information_the_existence_follows_the_chain() {
         *w = q;
     }
     for birth in [BirthProposal::Exact, SHARE] {
-        let e = existence(&mut BernoulliTbd::<250>::new(cfg(1e30, birth), 7).unwrap(), &run);
+        let e = existence(
+            &mut BernoulliTbd::<250>::new(cfg(1e30, birth), 7).unwrap(),
+            &run,
+        );
         for (f, (&got, &w)) in e.iter().zip(&want).enumerate() {
             assert!(
                 (got as f64 - w).abs() < 1e-4,
@@ -125,7 +136,10 @@ fn without_information_the_existence_follows_the_chain() {
         let mut sum = vec![0.0f64; k];
         let mut sq = vec![0.0f64; k];
         for seed in 0..S {
-            let e = existence(&mut PfTbd::<250>::new(cfg(1e30, birth), seed).unwrap(), &run);
+            let e = existence(
+                &mut PfTbd::<250>::new(cfg(1e30, birth), seed).unwrap(),
+                &run,
+            );
             for (i, &x) in e.iter().enumerate() {
                 sum[i] += x as f64;
                 sq[i] += (x as f64) * (x as f64);
@@ -171,7 +185,10 @@ fn fixed_share_tracks_at_15_db_like_the_exact_proposal() {
                 let dets: [(usize, Vec<f32>); 2] = [
                     (
                         0,
-                        existence(&mut PfTbd::<1000>::new(cfg(v, birth), 100 + s).unwrap(), &run),
+                        existence(
+                            &mut PfTbd::<1000>::new(cfg(v, birth), 100 + s).unwrap(),
+                            &run,
+                        ),
                     ),
                     (
                         1,

@@ -108,24 +108,25 @@ impl<const N: usize> PfTbd<N> {
         let lv_born = log_mass(beta) - math::ln(b as f32);
         let lv_absent = log_mass(1.0 - pb) - ln_rest;
         let lv_present = -ln_rest;
-        self.cloud.predict_and_weigh_split(z, b, |pt, birth, m, rng| {
-            if birth {
-                pt.x = m.prior.sample(rng);
-                pt.e = true;
-                lv_born
-            } else if !pt.e {
-                pt.x = [0.0; 3];
-                lv_absent
-            } else {
-                if rng.bernoulli(m.chain.death()) {
+        self.cloud
+            .predict_and_weigh_split(z, b, |pt, birth, m, rng| {
+                if birth {
+                    pt.x = m.prior.sample(rng);
+                    pt.e = true;
+                    lv_born
+                } else if !pt.e {
                     pt.x = [0.0; 3];
-                    pt.e = false;
+                    lv_absent
                 } else {
-                    pt.x = m.motion.propagate(pt.x, rng);
+                    if rng.bernoulli(m.chain.death()) {
+                        pt.x = [0.0; 3];
+                        pt.e = false;
+                    } else {
+                        pt.x = m.motion.propagate(pt.x, rng);
+                    }
+                    lv_present
                 }
-                lv_present
-            }
-        })
+            })
     }
 
     /// Restarts from frame 0 (the `Detector::reset` of this detector).
