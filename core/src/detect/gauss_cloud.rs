@@ -37,6 +37,9 @@ use crate::{Complex32, Error, Result};
     serde(rename_all = "kebab-case")
 )]
 pub enum BirthProposal {
+    // The firmware's zero-initialised statics hold an all-zero `GaussConfig` until
+    // `configure` installs a validated one; the const evaluator accepts it (the build
+    // fails if an all-zero value is not a valid enum value).
     /// Births sampled in their exact proportion (the preset; bit-identical to the
     /// detectors before the option existed).
     #[default]
