@@ -43,6 +43,18 @@ fn bad_arguments_fail_before_any_work() {
             "--sweep-h0-trials must lie in 11..=1000000, got 5",
         ),
         (&["--sweep-trials", "0"], "--sweep-trials must lie in"),
+        (
+            &["--birth-proposal", "fixed-share:1"],
+            "--birth-proposal: 'fixed-share:1': the share must lie in (0, 1)",
+        ),
+        (
+            &["--birth-proposal", "fixed-share:x"],
+            "--birth-proposal: 'fixed-share:x': 'x' is not a number",
+        ),
+        (
+            &["--birth-proposal", "fixed"],
+            "--birth-proposal: 'fixed' is neither 'exact' nor 'fixed-share:<s>'",
+        ),
     ]);
 }
 

@@ -2,6 +2,7 @@
 //! observation model, the noise generators, the detectors, their static configuration,
 //! the threshold calibration and the reproduction. One test binary for the family.
 
+mod birth;
 mod calibration;
 mod cli;
 #[path = "../common/cli.rs"]

@@ -25,6 +25,7 @@ fn quick_reproduction_writes_every_output() {
         comparator_var: Default::default(),
         comparator_likelihood: Default::default(),
         window: Default::default(),
+        birth_proposal: "exact".into(),
         quick: true,
     };
     run(&args).unwrap();

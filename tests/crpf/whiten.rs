@@ -104,6 +104,7 @@ fn window_aware_likelihood_is_calibrated_on_noise() {
         let g = GaussConfig {
             model: ModelConfig::othr(),
             noise_var: sc.bin_noise_var() as f32,
+            birth: Default::default(),
         };
         let mut a = BernoulliTbd::<1000>::new(g, r).unwrap();
         let mut rect = ModelConfig::othr();
@@ -112,6 +113,7 @@ fn window_aware_likelihood_is_calibrated_on_noise() {
             GaussConfig {
                 model: rect,
                 noise_var: (sc.noise_var * m as f64) as f32,
+                birth: Default::default(),
             },
             r,
         )

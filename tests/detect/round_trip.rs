@@ -116,6 +116,7 @@ fn doppler_detectors_round_trip() {
     let g = GaussConfig {
         model: ModelConfig::othr(),
         noise_var: var,
+        birth: Default::default(),
     };
     let want_crpf = doppler_rows(
         &run_detector(

@@ -4,17 +4,23 @@
 //! ```text
 //! q_{k|k-1} = Pb (1 - q_{k-1}) + Ps q_{k-1},   Ps = 1 - Pd
 //! predicted density: mixture of persisting F x + G v (mass Ps q) and births U(I_x0)
-//!                    (mass Pb (1 - q)); here sampled directly: each particle is a birth
-//!                    with probability rho = Pb (1 - q_{k-1}) / q_{k|k-1}
-//! I_k = (1/N) sum_i exp((2 Re<z,h_i> - ||h_i||^2) / s2)      (likelihood-ratio integral)
+//!                    (mass Pb (1 - q)), proposed as the config's `BirthProposal` says:
+//!   Exact:         each particle a birth with probability rho = Pb (1 - q_{k-1}) / q_{k|k-1},
+//!                  prior weights v_i = 1/N
+//!   FixedShare(s): B birth particles from U(I_x0) beside N - B persisting ones (Ristic,
+//!                  Vo, Vo, Farina 2013, sec. "particle filter implementation"), prior weights
+//!                  v_i = Pb (1 - q_{k-1}) / (B q_{k|k-1})       (births)
+//!                  v_i = Ps q_{k-1} / ((N - B) q_{k|k-1})       (persisting, Ps = 1 - Pd)
+//!   (frame 1 draws every particle from U(I_x0) with v_i = 1/N under both)
+//! I_k = sum_i v_i exp((2 Re<z,h_i> - ||h_i||^2) / s2)        (likelihood-ratio integral)
 //! q_k = q_{k|k-1} I_k / (1 - q_{k|k-1} + q_{k|k-1} I_k)
 //!     = 1 / (1 + exp(ln(1 - q_{k|k-1}) - ln q_{k|k-1} - ln I_k))   (log domain)
-//! w_i ∝ LR_i, estimate sum w_i x_i, resample N.
+//! w_i ∝ v_i LR_i, estimate sum w_i x_i, resample N.
 //! ```
 //! Noise assumed complex Gaussian, independent bins, variance `s2` (see
 //! [`GaussConfig`](super::pf_tbd::GaussConfig)).
 
-use super::gauss_cloud::{gauss_detector, GaussianCloud};
+use super::gauss_cloud::{gauss_detector, log_mass, GaussianCloud};
 use crate::math;
 use crate::model::doppler::DopplerReport;
 use crate::{Complex32, Result};
@@ -44,17 +50,56 @@ impl<const N: usize> BernoulliTbd<N> {
             1.0
         };
         let first = self.cloud.frame() == 0;
-        self.cloud.predict_and_weigh(z, |x, m, rng| {
-            *x = if first || rng.bernoulli(rho) {
-                m.prior.sample(rng)
+        // Validated at configuration: `None` is the exact proposal.
+        let fixed = match self.cloud.config().birth.birth_count::<N>() {
+            Ok(Some(b)) if !first => Some(b),
+            _ => None,
+        };
+        if let Some(b) = fixed {
+            // ln v of a birth and of a persisting particle, normalised by their total
+            // (q_pred up to rounding). A zero mass gives -inf (those particles carry no
+            // weight); both zero (q_pred = 0, q stays 0 below): uniform.
+            let persist_mass = (1.0 - chain.death()) * self.q;
+            let total = born_mass + persist_mass;
+            let (lv_born, lv_persist) = if total > 0.0 {
+                let ln_t = math::ln(total);
+                (
+                    log_mass(born_mass) - math::ln(b as f32) - ln_t,
+                    log_mass(persist_mass) - math::ln((N as u32 - b) as f32) - ln_t,
+                )
             } else {
-                m.motion.propagate(*x, rng)
+                (0.0, 0.0)
             };
-        })?;
-        // ln I_k = LSE(ln LR) - ln N; finite for a finite frame.
+            self.cloud
+                .predict_and_weigh_split(z, b, |x, birth, m, rng| {
+                    if birth {
+                        *x = m.prior.sample(rng);
+                        lv_born
+                    } else {
+                        *x = m.motion.propagate(*x, rng);
+                        lv_persist
+                    }
+                })?;
+        } else {
+            self.cloud.predict_and_weigh(z, |x, m, rng| {
+                *x = if first || rng.bernoulli(rho) {
+                    m.prior.sample(rng)
+                } else {
+                    m.motion.propagate(*x, rng)
+                };
+            })?;
+        }
+        // ln I_k = LSE(ln v + ln LR): minus ln N for the exact proposal (v = 1/N), the
+        // prior weights are in the log weights for the fixed share. Finite for a finite
+        // frame.
+        let ln_v = if fixed.is_some() {
+            0.0
+        } else {
+            math::ln(N as f32)
+        };
         let q = match self.cloud.normalise() {
             Some(lse) => {
-                let ln_i = lse - math::ln(N as f32);
+                let ln_i = lse - ln_v;
                 if q_pred <= 0.0 {
                     0.0
                 } else if q_pred >= 1.0 {

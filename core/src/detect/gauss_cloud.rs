@@ -19,6 +19,65 @@ use crate::particles::{gather_in_place, resample, Scheme};
 use crate::rng::Rng;
 use crate::{Complex32, Error, Result};
 
+/// How PF-TBD and JOTT propose their births; the target law (the predicted density) is
+/// the same for both, only the importance proposal differs. PF-LRT has no births and
+/// ignores it.
+///
+/// ```text
+/// Exact:          JOTT: each particle a birth with probability rho = Pb (1 - q) / q_{k|k-1};
+///                 PF-TBD: each absent particle born with probability Pb (eq. 9 chain)
+/// FixedShare(s):  B = round(s N) clamped to 1..=N-1 birth particles from U(I_x0) every
+///                 frame in systematically spread slots, the other N - B persisting,
+///                 importance weights carrying the masses (see the two detectors)
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "kebab-case")
+)]
+pub enum BirthProposal {
+    // The firmware's zero-initialised statics hold an all-zero `GaussConfig` until
+    // `configure` installs a validated one; the const evaluator accepts it (the build
+    // fails if an all-zero value is not a valid enum value).
+    /// Births sampled in their exact proportion (the preset; bit-identical to the
+    /// detectors before the option existed).
+    #[default]
+    Exact,
+    /// A fixed share `s` of the particles, `0 < s < 1`, proposed as births every frame
+    /// (needs `N >= 2`); `B = round(s N)` clamped to `1..=N-1`.
+    FixedShare(f32),
+}
+
+impl BirthProposal {
+    /// `B` for `N` particles: `None` for [`Exact`](Self::Exact). Errors
+    /// ([`Error::InvalidConfig`]): a share that is not finite or not in `(0, 1)`, or
+    /// `N < 2` with a fixed share.
+    pub fn birth_count<const N: usize>(&self) -> Result<Option<u32>> {
+        match *self {
+            BirthProposal::Exact => Ok(None),
+            BirthProposal::FixedShare(s) => {
+                if !(s.is_finite() && s > 0.0 && s < 1.0) {
+                    return Err(Error::InvalidConfig(
+                        "birth proposal share must be finite and in (0, 1)",
+                    ));
+                }
+                let n = match u32::try_from(N) {
+                    Ok(n) if (2..=1 << 31).contains(&n) => n,
+                    _ => {
+                        return Err(Error::InvalidConfig(
+                            "fixed-share birth proposal needs 2 <= N <= 2^31 particles",
+                        ))
+                    }
+                };
+                // s N in (0, N): the saturating conversion lands in 0..=N.
+                let b = math::round(s * N as f32) as u32;
+                Ok(Some(b.clamp(1, n - 1)))
+            }
+        }
+    }
+}
+
 /// Runtime values shared by the Gaussian comparators (PF-TBD, JOTT, PF-LRT).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(
@@ -31,14 +90,19 @@ pub struct GaussConfig {
     pub model: ModelConfig,
     /// Per-bin complex noise variance `s2 = E|w_b|^2` (> 0).
     pub noise_var: f32,
+    /// Birth proposal of PF-TBD and JOTT (ignored by PF-LRT); absent in serialised
+    /// configurations means [`BirthProposal::Exact`].
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub birth: BirthProposal,
 }
 
 impl GaussConfig {
-    /// OTHR preset with a given noise variance.
+    /// OTHR preset with a given noise variance (exact birth proposal).
     pub fn othr(noise_var: f32) -> Self {
         Self {
             model: ModelConfig::othr(),
             noise_var,
+            birth: BirthProposal::Exact,
         }
     }
 
@@ -48,12 +112,13 @@ impl GaussConfig {
         self.model.build()
     }
 
-    /// What every Gaussian comparator's `new` / `configure` needs: `N > 0`, the built
-    /// model and `1 / s2`.
+    /// What every Gaussian comparator's `new` / `configure` needs: `N > 0`, a valid birth
+    /// proposal for `N`, the built model and `1 / s2`.
     pub(crate) fn prepare<const N: usize>(&self) -> Result<(Model, f32)> {
         if N == 0 {
             return Err(Error::InvalidConfig("particle count N = 0"));
         }
+        self.birth.birth_count::<N>()?;
         let model = self.build()?;
         Ok((model, 1.0 / self.noise_var))
     }
@@ -73,6 +138,16 @@ fn check_variance(v: f32) -> Result<f32> {
         Err(Error::InvalidConfig(
             "noise variance must be finite and > 0",
         ))
+    }
+}
+
+/// `ln x` for a probability mass `x`: `-inf` for `x <= 0` (or NaN), whatever the `ln`
+/// implementation does at 0.
+pub(crate) fn log_mass(x: f32) -> f32 {
+    if x > 0.0 {
+        math::ln(x)
+    } else {
+        f32::NEG_INFINITY
     }
 }
 
@@ -232,6 +307,47 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
             };
         }
         Ok(())
+    }
+
+    /// [`predict_and_weigh`](Self::predict_and_weigh) for a fixed-share birth proposal:
+    /// of the `N` slots exactly `births` (`1..N`, validated by
+    /// [`BirthProposal::birth_count`]) are birth slots, spread systematically over the
+    /// (resampled, ancestor-sorted) array: with one offset `o` uniform on `0..N`, slot `i`
+    /// is a birth slot iff `floor((o + (i+1) B) / N) > floor((o + i B) / N)`, so each slot
+    /// is one with probability `B / N` and the other `N - B` are a systematic subsample of
+    /// the previous particles. `step(p, birth_slot, m, rng)` moves a particle and returns
+    /// its log prior weight `ln v_i`; its log weight becomes
+    /// `ln v_i + (2 Re<z,h> - ||h||^2) / s2` (`ln v_i` without a target).
+    pub(crate) fn predict_and_weigh_split(
+        &mut self,
+        z: &[Complex32],
+        births: u32,
+        mut step: impl FnMut(&mut P, bool, &Model, &mut Rng) -> f32,
+    ) -> Result<()> {
+        check_frame(z, self.model.obs.bins())?;
+        let m = &self.model;
+        // 2 <= N <= 2^31 and births < N (birth_count): acc + births < 2^32, and acc stays
+        // below N after each step.
+        let n = N as u32;
+        let mut acc = self.rng.below(n);
+        for (p, lw) in self.parts.iter_mut().zip(self.log_w.iter_mut()) {
+            acc += births;
+            let birth_slot = acc >= n;
+            if birth_slot {
+                acc -= n;
+            }
+            let prior = step(p, birth_slot, m, &mut self.rng);
+            *lw = match p.target() {
+                Some(x) => prior + m.obs.project_re(z, x[0], x[2]).log_lr(self.inv_var),
+                None => prior,
+            };
+        }
+        Ok(())
+    }
+
+    /// Particles without a target.
+    pub(crate) fn absent_count(&self) -> usize {
+        self.parts.iter().filter(|p| p.target().is_none()).count()
     }
 
     /// Normalises the log weights; returns `LSE = ln sum_i exp(ln w_i)`. Log weights are

@@ -30,7 +30,7 @@ use cortex_m_rt::entry;
 use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd, Weighting};
 use faint_core::detect::pf_lrt::PfLrt;
-use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint_core::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd};
 use faint_core::detect::{run as run_frames, Detector, Validate};
 use faint_core::model::doppler::{
     check_frame, dtft, estimate_noise_variance, max_amplitude, unwindow, DopplerModel, ModelConfig,
@@ -315,10 +315,16 @@ fn family<const N: usize>(
     let white = GaussConfig {
         model: rect,
         noise_var: black_box(M as f32) * black_box(1.0),
+        birth: Default::default(),
+    };
+    let shared = GaussConfig {
+        birth: BirthProposal::FixedShare(black_box(0.1)),
+        ..ham
     };
     for (cfg, model, whiten) in [
         (ham, &model_h, None),
         (white, &model_r, Some(Window::Hamming)),
+        (shared, &model_h, None),
     ] {
         ok &= pf.configure(&cfg, black_box(1)).is_ok();
         ok &= exercise(pf, model, whiten, rng);
@@ -337,6 +343,15 @@ fn family<const N: usize>(
         .configure(
             &GaussConfig {
                 noise_var: black_box(0.0),
+                ..ham
+            },
+            0,
+        )
+        .is_err();
+    ok &= jott
+        .configure(
+            &GaussConfig {
+                birth: BirthProposal::FixedShare(black_box(1.0)),
                 ..ham
             },
             0,

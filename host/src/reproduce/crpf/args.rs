@@ -8,6 +8,7 @@ use anyhow::{ensure, Result};
 use super::evaluation::{ComparatorModel, Likelihood, VarSource};
 use crate::cli;
 use crate::scenario::crpf::{Noise, Othr};
+use faint_core::detect::pf_tbd::BirthProposal;
 use faint_core::model::doppler::Window;
 
 /// Analysis window of the scene and every detector's model (`--window`).
@@ -83,6 +84,12 @@ pub struct Args {
     /// Analysis window of the scene and of every detector's model.
     #[arg(long, value_enum, default_value_t = SceneWindow::Hamming)]
     pub window: SceneWindow,
+    /// Birth proposal of PF-TBD and JOTT: `exact` (the preset: JOTT births in their exact
+    /// proportion, PF-TBD's absent particles born at rate Pb) or `fixed-share:<s>` (a
+    /// share s in (0, 1) of the particles proposed as births every frame, importance
+    /// weights keeping the same law; faint_core::detect::pf_tbd::BirthProposal).
+    #[arg(long, default_value = "exact")]
+    pub birth_proposal: String,
     /// Small defaults for CI: N = 100, 60 H1 runs per point, 400 H0 runs, Pfa 0.05,
     /// SNR 0:16:4, sweeps with 200 + 40 runs; never overrides a value given.
     #[arg(long)]
@@ -107,6 +114,7 @@ pub(super) struct Settings {
     pub(super) comparator_var: VarSource,
     pub(super) comparator_likelihood: Likelihood,
     pub(super) window: SceneWindow,
+    pub(super) birth: BirthProposal,
 }
 
 impl Args {
@@ -150,6 +158,7 @@ impl Args {
             "--sweep-trials",
             self.sweep_trials.unwrap_or(if q { 40 } else { 500 }),
         )?;
+        let birth = birth_proposal(&self.birth_proposal)?;
         Ok(Settings {
             particles,
             trials,
@@ -166,6 +175,7 @@ impl Args {
             comparator_var: self.comparator_var,
             comparator_likelihood: self.comparator_likelihood,
             window: self.window,
+            birth,
         })
     }
 
@@ -173,7 +183,8 @@ impl Args {
     /// once, not after the H0 runs): `--pfa` in `(0, 1)`; a supported `--particles`;
     /// run counts in `1..=1000000`; enough `--h0-trials` that the calibration's halves
     /// resolve `--pfa` (each half must hold at least `1 / pfa` runs); a valid `--snr-db`
-    /// grid; more than 10 sweep H0 runs.
+    /// grid; more than 10 sweep H0 runs; a `--birth-proposal` of `exact` or
+    /// `fixed-share:<s>` with `s` in (0, 1).
     pub fn validate(&self) -> Result<()> {
         self.effective().map(|_| ())
     }
@@ -186,11 +197,13 @@ impl Settings {
             var: self.comparator_var,
             likelihood: self.comparator_likelihood,
             time_var: sc.noise_var,
+            birth: self.birth,
         }
     }
 
-    /// Output sub-directory: `<noise>_n<N>`, with `_var-true`, `_lik-window`, `_rect`
-    /// for the non-preset comparator variance, likelihood and window.
+    /// Output sub-directory: `<noise>_n<N>`, with `_var-true`, `_lik-window`, `_rect`,
+    /// `_birth-fs<s>` for the non-preset comparator variance, likelihood, window and birth
+    /// proposal.
     pub(super) fn tag(&self) -> String {
         let mut t = format!("{:?}_n{}", self.noise, self.particles).to_lowercase();
         if self.comparator_var == VarSource::True {
@@ -202,9 +215,31 @@ impl Settings {
         if self.window == SceneWindow::Rectangular {
             t += "_rect";
         }
+        if let BirthProposal::FixedShare(s) = self.birth {
+            t += &format!("_birth-fs{s}");
+        }
         t
     }
 }
 
 /// Particle counts `faint reproduce crpf` is compiled for (see [`run_stats`](super::run_stats)).
 pub const PARTICLES: [usize; 7] = [100, 250, 500, 1000, 2000, 4000, 6000];
+
+/// `--birth-proposal`: `exact` or `fixed-share:<s>`, `s` finite in (0, 1) (the particle
+/// count then gives `B = round(s N)`, clamped to `1..=N-1`).
+fn birth_proposal(v: &str) -> Result<BirthProposal> {
+    if v == "exact" {
+        return Ok(BirthProposal::Exact);
+    }
+    let Some(share) = v.strip_prefix("fixed-share:") else {
+        anyhow::bail!("--birth-proposal: '{v}' is neither 'exact' nor 'fixed-share:<s>'");
+    };
+    let s: f32 = share
+        .parse()
+        .map_err(|_| anyhow::anyhow!("--birth-proposal: '{v}': '{share}' is not a number"))?;
+    ensure!(
+        s.is_finite() && s > 0.0 && s < 1.0,
+        "--birth-proposal: '{v}': the share must lie in (0, 1)"
+    );
+    Ok(BirthProposal::FixedShare(s))
+}

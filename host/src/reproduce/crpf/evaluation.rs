@@ -7,7 +7,7 @@ use anyhow::{bail, Result};
 use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint_core::detect::pf_lrt::PfLrt;
-use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint_core::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd};
 use faint_core::detect::Detector;
 use faint_core::model::doppler::{estimate_noise_variance, unwindow, DopplerReport, Window};
 use faint_core::rng::{derive_seed, Rng};
@@ -93,6 +93,8 @@ pub struct ComparatorModel {
     pub likelihood: Likelihood,
     /// The scene's time-domain noise variance (for [`VarSource::True`]).
     pub time_var: f64,
+    /// Birth proposal of PF-TBD and JOTT (`--birth-proposal`).
+    pub birth: BirthProposal,
 }
 
 impl Default for ComparatorModel {
@@ -101,6 +103,7 @@ impl Default for ComparatorModel {
             var: VarSource::Run,
             likelihood: Likelihood::Independent,
             time_var: 1.0,
+            birth: BirthProposal::Exact,
         }
     }
 }
@@ -157,7 +160,14 @@ fn comparator_input(
             (cm.time_var * e) as f32
         }
     };
-    Ok((whitened, GaussConfig { model, noise_var }))
+    Ok((
+        whitened,
+        GaussConfig {
+            model,
+            noise_var,
+            birth: cm.birth,
+        },
+    ))
 }
 
 /// Runs a detector over a run's frames; returns the per-frame reports.
