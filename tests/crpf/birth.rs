@@ -6,11 +6,13 @@ use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd};
 use faint::core::detect::Detector;
-use faint::core::model::doppler::{estimate_noise_variance, DopplerReport};
+use faint::core::model::doppler::DopplerReport;
 use faint::core::rng::Rng;
 use faint::core::{Complex32, Error};
 use faint::host::reproduce::crpf::run_detector;
 use faint::host::scenario::crpf::{Noise, Othr, Run};
+
+use super::detectors::var_of;
 
 const SHARE: BirthProposal = BirthProposal::FixedShare(0.1);
 
@@ -30,10 +32,6 @@ fn existence<D: Detector<Frame = [Complex32], Report = DopplerReport>>(
         .iter()
         .map(|r| r.existence)
         .collect()
-}
-
-fn var_of(run: &Run) -> f32 {
-    estimate_noise_variance(run.frames.iter().map(|f| f.as_slice()), 32).unwrap()
 }
 
 fn mean(v: &[f32], frames: std::ops::RangeInclusive<usize>) -> f32 {

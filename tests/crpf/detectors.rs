@@ -44,7 +44,8 @@ fn detectors(var: f32, seed: u64) -> Vec<(&'static str, Box<dyn Doppler>)> {
     ]
 }
 
-fn var_of(run: &Run) -> f32 {
+/// The run's per-bin noise variance as the comparators estimate it (32 bins).
+pub(crate) fn var_of(run: &Run) -> f32 {
     estimate_noise_variance(run.frames.iter().map(|f| f.as_slice()), 32).unwrap()
 }
 
