@@ -121,10 +121,16 @@ impl DopplerModel {
         if !(ts.is_finite() && ts > 0.0) {
             return Err(Error::InvalidConfig("sample interval ts"));
         }
+        // The window's coefficients once, not once per table point (same bits).
+        let mut w = [0.0f64; MAX_BINS];
+        for (n, c) in w.iter_mut().enumerate().take(m) {
+            *c = window.coefficient(n, m);
+        }
+        let w = w.get(..m).unwrap_or(&[]);
         let mut table = [Complex32::new(0.0, 0.0); TABLE_LEN];
         for (t, slot) in table.iter_mut().enumerate() {
             let u = -(HALF_SPAN as f64 + 0.5) + t as f64 / TABLE_STEPS as f64;
-            let (re, im) = dtft(window, m, u / m as f64);
+            let (re, im) = dtft_of(w.iter().copied(), u / m as f64);
             *slot = Complex32::new(re as f32, im as f32);
         }
         let mut rows = [[[0.0f32; 4]; SPAN]; TABLE_STEPS];
@@ -365,13 +371,59 @@ fn kernel<const IM: bool>(row: &Row, zs: &[Complex32; SPAN], frac: f32) -> (f32,
 
 /// `W(theta) = sum_n w_n exp(j 2 pi theta n)` in `f64`.
 pub fn dtft(window: Window, m: usize, theta: f64) -> (f64, f64) {
+    dtft_of((0..m).map(|n| window.coefficient(n, m)), theta)
+}
+
+/// [`dtft`] of the coefficients `w` (one `sincos` per sample: the same bits as `sin`
+/// and `cos` apart, which share its argument reduction and kernels).
+fn dtft_of(w: impl Iterator<Item = f64>, theta: f64) -> (f64, f64) {
     let mut re = 0.0;
     let mut im = 0.0;
-    for n in 0..m {
-        let w = window.coefficient(n, m);
+    for (n, wn) in w.enumerate() {
         let ph = 2.0 * core::f64::consts::PI * theta * n as f64;
-        re += w * libm::cos(ph);
-        im += w * libm::sin(ph);
+        let (s, c) = libm::sincos(ph);
+        re += wn * c;
+        im += wn * s;
     }
     (re, im)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The table is built with one `sincos` per sample and the window's coefficients
+    /// computed once; the reference below is the textbook form (a `cos`, a `sin` and the
+    /// window's `cos` per sample). Every table value must have the same bits, for every
+    /// window and bin count the model accepts.
+    #[test]
+    fn table_has_the_bits_of_separate_sin_and_cos() {
+        fn reference(window: Window, m: usize, theta: f64) -> (f32, f32) {
+            let (mut re, mut im) = (0.0f64, 0.0f64);
+            for n in 0..m {
+                let w = window.coefficient(n, m);
+                let ph = 2.0 * core::f64::consts::PI * theta * n as f64;
+                re += w * libm::cos(ph);
+                im += w * libm::sin(ph);
+            }
+            (re as f32, im as f32)
+        }
+        for window in [Window::Rectangular, Window::Hamming, Window::Hann] {
+            for m in SPAN..=MAX_BINS {
+                let model = DopplerModel::new(m, 1e-3, window).expect("valid model");
+                for (i0, row) in model.rows.iter().enumerate() {
+                    for (j, cell) in row.iter().enumerate() {
+                        let t = i0 + (SPAN - 1 - j) * TABLE_STEPS;
+                        let u = -(HALF_SPAN as f64 + 0.5) + t as f64 / TABLE_STEPS as f64;
+                        let (re, im) = reference(window, m, u / m as f64);
+                        assert_eq!(
+                            (cell[0].to_bits(), cell[1].to_bits()),
+                            (re.to_bits(), im.to_bits()),
+                            "{window:?}, m = {m}, t = {t}"
+                        );
+                    }
+                }
+            }
+        }
+    }
 }
