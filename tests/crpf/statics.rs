@@ -97,3 +97,69 @@ fn reconfigure_equals_new() {
     };
     assert!(z.configure(&bad, 1).is_err());
 }
+
+/// `configure` reuses the response table when bins, sample interval and window are
+/// unchanged and rebuilds it otherwise: a detector reconfigured from another frame format
+/// (window or sample interval), or from the same one with other settings, reports exactly
+/// what a new detector does.
+#[test]
+fn reconfigure_reuses_the_table_only_for_the_same_frame_format() {
+    let seed = 11;
+    let cfg = CrpfConfig::othr();
+    let hann = CrpfConfig {
+        model: faint::core::model::doppler::ModelConfig {
+            window: Window::Hann,
+            ..cfg.model
+        },
+        ..cfg
+    };
+    let slower = CrpfConfig {
+        model: faint::core::model::doppler::ModelConfig {
+            ts: cfg.model.ts * 0.8,
+            ..cfg.model
+        },
+        ..cfg
+    };
+    let same_table = CrpfConfig { lambda: 0.3, ..cfg };
+    for target in [cfg, hann, slower, same_table] {
+        let want = run(&mut CrpfTbd::<N>::new(target, seed).unwrap());
+        for from in [cfg, hann, slower, same_table] {
+            let mut d = CrpfTbd::<N>::new(from, 3).unwrap();
+            let _ = run(&mut d);
+            d.configure(&target, seed).unwrap();
+            assert_eq!(run(&mut d), want, "{from:?} -> {target:?}");
+        }
+    }
+
+    let g = GaussConfig::othr(12.7);
+    let g_hann = GaussConfig {
+        model: hann.model,
+        ..g
+    };
+    let g_slower = GaussConfig {
+        model: slower.model,
+        ..g
+    };
+    let g_var = GaussConfig {
+        noise_var: 3.0,
+        ..g
+    };
+    fn check<D>(make: impl Fn(GaussConfig, u64) -> D, cfgs: [GaussConfig; 4])
+    where
+        D: Detector<Frame = [Complex32], Report = DopplerReport, Config = GaussConfig>,
+    {
+        for target in cfgs {
+            let want = run(&mut make(target, 11));
+            for from in cfgs {
+                let mut d = make(from, 3);
+                let _ = run(&mut d);
+                d.configure(&target, 11).unwrap();
+                assert_eq!(run(&mut d), want, "{from:?} -> {target:?}");
+            }
+        }
+    }
+    let cfgs = [g, g_hann, g_slower, g_var];
+    check(|c, s| PfTbd::<N>::new(c, s).unwrap(), cfgs);
+    check(|c, s| BernoulliTbd::<N>::new(c, s).unwrap(), cfgs);
+    check(|c, s| PfLrt::<N>::new(c, s).unwrap(), cfgs);
+}

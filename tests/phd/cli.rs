@@ -38,6 +38,23 @@ fn reproduce_psophd_rejects_bad_arguments_before_any_run() {
         (vec!["--birth-pair-speed=-3"], "--birth-pair-speed"),
         (vec!["--birth-pair-speed=inf"], "--birth-pair-speed"),
         (vec!["--snr-db", "nan"], "--snr-db"),
+        (vec!["--variants", "phd-tbd,kmeans"], "--variants: 'kmeans'"),
+        (
+            vec!["--variants", "phd-tbd,phd-tbd"],
+            "--variants: 'phd-tbd' is given twice",
+        ),
+        (vec!["--filter-q1", "0"], "--filter-q1 must be > 0"),
+        (vec!["--filter-q1", "inf"], "--filter-q1"),
+        (vec!["--clutter-lambda=-1"], "--clutter-lambda must be > 0"),
+        (vec!["--birth-mass", "1"], "--birth-mass must lie in (0, 1)"),
+        (
+            vec!["--birth-particles", "0"],
+            "--birth-particles must lie in 1..=4096",
+        ),
+        (
+            vec!["--particles-per-target", "9000"],
+            "--particles-per-target must lie in 1..=8192",
+        ),
     ] {
         let out = Command::new(env!("CARGO_BIN_EXE_faint"))
             .args(["--quiet", "reproduce", "psophd", "--runs", "100000"])
@@ -128,5 +145,39 @@ fn quick_keeps_given_values() {
     for r in rows {
         assert!(r.starts_with("7.0,") && r.contains(",1,"), "{summary}");
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The ablation algorithm (PHD-TBD with DBSCAN) runs beside the paper's three, only the
+/// selected algorithms are written, and the summary carries the count error and the
+/// all-alive columns.
+#[test]
+fn variants_select_the_algorithms_and_the_ablation_runs() {
+    let dir = std::env::temp_dir().join(format!("faint-phd-variants-{}", std::process::id()));
+    let out = dir.to_str().unwrap();
+    let (code, stderr) = phd(&[
+        "--quick",
+        "--variants",
+        "phd-tbd-dbscan,phd-tbd",
+        "--filter-q1",
+        "2",
+        "--out",
+        out,
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let table = std::fs::read_to_string(dir.join("table.md")).unwrap();
+    assert!(table.contains("PHD-TBD (DBSCAN)"), "{table}");
+    assert!(!table.contains("PSO-PHD-TBD"), "{table}");
+    let summary = std::fs::read_to_string(dir.join("summary.csv")).unwrap();
+    let head = summary.lines().next().unwrap();
+    for col in [
+        "mean_abs_count_error",
+        "all_alive_mean_count",
+        "all_alive_mean_ospa_m",
+    ] {
+        assert!(head.contains(col), "{head}");
+    }
+    let frames = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
+    assert_eq!(frames.lines().count(), 1 + 2 * 40);
     let _ = std::fs::remove_dir_all(&dir);
 }

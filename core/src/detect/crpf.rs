@@ -65,8 +65,8 @@ use crate::detect::{Detection, Detector, ScoreKind, Validate};
 use crate::existence::{BirthGaps, ExistenceDraw};
 use crate::math::{self, KahanSum};
 use crate::model::doppler::{
-    check_frame, finite_estimate, DopplerReport, Model, ModelConfig, Motion, ProjectionCache,
-    DOPPLER_STATE, MAX_BINS,
+    check_frame, finite_estimate, DopplerModel, DopplerReport, Model, ModelConfig, Motion,
+    ProjectionCache, DOPPLER_STATE, MAX_BINS,
 };
 use crate::particles::{gather_flagged, resample, systematic_with_sum, FlaggedState, Scheme};
 use crate::rng::Rng;
@@ -132,6 +132,12 @@ impl CrpfConfig {
 
     /// Checks every value and builds the model.
     pub(crate) fn build(&self) -> Result<Model> {
+        self.build_reusing(None)
+    }
+
+    /// [`CrpfConfig::build`], reusing `old`'s response table when it fits
+    /// ([`ModelConfig::build_reusing`](crate::model::doppler::ModelConfig::build_reusing)).
+    pub(crate) fn build_reusing(&self, old: Option<&DopplerModel>) -> Result<Model> {
         if !(self.p.is_finite() && self.p > 0.0) {
             return Err(Error::InvalidConfig("cost exponent p"));
         }
@@ -149,7 +155,7 @@ impl CrpfConfig {
         if !(0.0..=1.0).contains(&self.r_th) {
             return Err(Error::InvalidConfig("correlation threshold r_th"));
         }
-        let model = self.model.build()?;
+        let model = self.model.build_reusing(old)?;
         // At most one band width, one alias-free Doppler rate and the largest amplitude.
         let w = model.motion.band_width();
         let limits = [
@@ -933,7 +939,7 @@ impl<const N: usize> Detector for CrpfTbd<N> {
         if u32::try_from(N).is_err() {
             return Err(Error::IndexOutOfRange);
         }
-        let model = cfg.build()?;
+        let model = cfg.build_reusing(Some(&self.model.obs))?;
         self.int_exponent = int_exponent(cfg);
         self.births = BirthGaps::new(&model.chain);
         self.cfg = *cfg;

@@ -14,7 +14,7 @@
 
 use crate::detect::Validate;
 use crate::math;
-use crate::model::doppler::{check_frame, DopplerReport, Model, ModelConfig, Motion};
+use crate::model::doppler::{check_frame, DopplerModel, DopplerReport, Model, ModelConfig, Motion};
 use crate::particles::{gather_in_place, resample, Scheme};
 use crate::rng::Rng;
 use crate::{Complex32, Error, Result};
@@ -108,18 +108,27 @@ impl GaussConfig {
 
     /// Checks the variance and builds the model.
     pub(crate) fn build(&self) -> Result<Model> {
+        self.build_reusing(None)
+    }
+
+    /// [`GaussConfig::build`], reusing `old`'s response table when it fits
+    /// ([`ModelConfig::build_reusing`](crate::model::doppler::ModelConfig::build_reusing)).
+    fn build_reusing(&self, old: Option<&DopplerModel>) -> Result<Model> {
         check_variance(self.noise_var)?;
-        self.model.build()
+        self.model.build_reusing(old)
     }
 
     /// What every Gaussian comparator's `new` / `configure` needs: `N > 0`, a valid birth
-    /// proposal for `N`, the built model and `1 / s2`.
-    pub(crate) fn prepare<const N: usize>(&self) -> Result<(Model, f32)> {
+    /// proposal for `N`, the built model (reusing `old`'s table when it fits) and `1 / s2`.
+    pub(crate) fn prepare<const N: usize>(
+        &self,
+        old: Option<&DopplerModel>,
+    ) -> Result<(Model, f32)> {
         if N == 0 {
             return Err(Error::InvalidConfig("particle count N = 0"));
         }
         self.birth.birth_count::<N>()?;
-        let model = self.build()?;
+        let model = self.build_reusing(old)?;
         Ok((model, 1.0 / self.noise_var))
     }
 }
@@ -227,7 +236,7 @@ pub(crate) struct GaussianCloud<P, const N: usize> {
 impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
     /// Validates `cfg`; particles are default until [`reset`](Self::reset).
     pub(crate) fn new(cfg: GaussConfig) -> Result<Self> {
-        let (model, inv_var) = cfg.prepare::<N>()?;
+        let (model, inv_var) = cfg.prepare::<N>(None)?;
         Ok(Self {
             cfg,
             model,
@@ -245,7 +254,7 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
     /// Re-validates `cfg` and installs it; on error `self` is unchanged. The caller
     /// [`reset`](Self::reset)s next.
     pub(crate) fn reconfigure(&mut self, cfg: GaussConfig) -> Result<()> {
-        let (model, inv_var) = cfg.prepare::<N>()?;
+        let (model, inv_var) = cfg.prepare::<N>(Some(&self.model.obs))?;
         self.cfg = cfg;
         self.model = model;
         self.inv_var = inv_var;

@@ -39,10 +39,13 @@
 //! instructions, see `harness.rs`) and the board's dual timer for the wraps of the 32-bit
 //! timer. A block line gives the block's mean and largest count per frame and two
 //! detector-specific block means (work counters: `w1`, `w2`, see [`Spec`]). The peak
-//! stack is the deepest write into a painted 64 KiB window below the soak loop's frame,
-//! read at every block's end, before the block's line is printed (the window is painted
-//! again after it): an upper bound on `step`'s stack (it includes the frame
-//! generator and the output check).
+//! stack is the deepest write into a painted 16 KiB window below the soak loop's frame,
+//! read after every `step` and painted again after the output check: the deeper of the
+//! frame generator's and `step`'s stack (the generator's is 172 B). The output check is
+//! left out: it formats the report's floats, and `core::fmt`'s rare Dragon4 fallback
+//! (Grisu fails on a few values) goes ~1.6 KB deeper than the shortest path. `phases=1`
+//! measures generator, `step` and check apart (a diagnostic: one paint and one scan per
+//! phase) and prints each one's peak with the first frame that reached it.
 #![no_std]
 #![no_main]
 
@@ -54,6 +57,7 @@ use core::fmt::{self, Debug, Write};
 use core::hint::black_box;
 use core::mem::{size_of, MaybeUninit};
 use core::ptr::{read_volatile, write_volatile};
+use core::sync::atomic::{AtomicBool, Ordering};
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
@@ -92,6 +96,12 @@ struct Args {
     only: Text<256>,
 }
 
+/// `phases=1`: the peak stack of each phase of a frame (generator, `step`, output check)
+/// is measured on its own, the window painted before each (a diagnostic: it costs a
+/// paint and a scan of the 64 KiB window per phase), and reported per detector with the
+/// frame that first reached it.
+static PHASES: AtomicBool = AtomicBool::new(false);
+
 static mut CMDLINE: [u8; 256] = [0; 256];
 
 impl Args {
@@ -121,6 +131,8 @@ impl Args {
                 if let Ok(f) = v.parse::<u32>() {
                     args.frames = f.max(1);
                 }
+            } else if word == "phases=1" {
+                PHASES.store(true, Ordering::Relaxed);
             } else if let Some(v) = word.strip_prefix("only=") {
                 args.only.clear();
                 let _ = args.only.write_str(v);
@@ -166,6 +178,10 @@ fn coarse() -> u32 {
     unsafe { read_volatile(DUAL_VALUE) }
 }
 
+/// Stack window painted below the soak loop's frame (every detector's step measured so
+/// far stays under 4.5 KiB; a row at `WINDOW` means at least that much).
+const WINDOW: usize = 16 * 1024;
+
 /// Instructions of an empty [`count`] (subtracted).
 static mut BASELINE: u64 = 0;
 
@@ -181,6 +197,32 @@ fn count<R>(f: impl FnOnce() -> R) -> (R, u64) {
     // SAFETY: written once before any detector runs; single-threaded.
     let base = unsafe { BASELINE };
     (r, (fine + wraps * WRAP).saturating_sub(base))
+}
+
+/// The deepest stack one phase of a frame reached and the first frame that reached it.
+#[derive(Default, Clone, Copy)]
+struct Peak {
+    bytes: usize,
+    frame: u64,
+}
+
+/// Runs one phase of frame `frame` on a freshly painted window `[lo, hi)` and raises
+/// `peak` to its stack below `top` (`phases=1`).
+fn phase<R>(
+    top: usize,
+    lo: usize,
+    hi: usize,
+    peak: &mut Peak,
+    frame: u64,
+    f: impl FnOnce() -> R,
+) -> R {
+    paint(lo, hi);
+    let r = f();
+    let bytes = top - lowest_touched(lo, hi);
+    if bytes > peak.bytes {
+        *peak = Peak { bytes, frame };
+    }
+    r
 }
 
 // ---------------------------------------------------------------------------------------
@@ -314,15 +356,33 @@ where
     let mut blocks = 0u32;
     let mut b = Block::default();
     let sp = cortex_m::register::msp::read() as usize;
-    let lo = sp - harness::STACK_WINDOW;
+    let lo = sp - WINDOW;
     let hi = sp - harness::PAINT_MARGIN;
     paint(lo, hi);
     let mut deepest = hi;
-    for _ in 0..frames {
-        let n = (spec.frame)(&mut rng, spec.buf);
+    let phases = PHASES.load(Ordering::Relaxed);
+    let mut peaks = [Peak::default(); 3];
+    for i in 0..u64::from(frames) {
+        let [gen, stepped, checked] = &mut peaks;
+        let n = if phases {
+            phase(sp, lo, hi, gen, i, || (spec.frame)(&mut rng, spec.buf))
+        } else {
+            (spec.frame)(&mut rng, spec.buf)
+        };
         let frame = &spec.buf[..n];
-        let (r, instr) = count(|| det.step(black_box(frame)));
-        match r {
+        let (r, instr) = if phases {
+            phase(sp, lo, hi, stepped, i, || {
+                count(|| det.step(black_box(frame)))
+            })
+        } else {
+            count(|| det.step(black_box(frame)))
+        };
+        // Generator and step only: the output check formats floats, whose rare
+        // Dragon4 fallback alone goes ~1.6 KB deeper (located with `phases=1`).
+        if !phases {
+            deepest = deepest.min(lowest_touched(lo, hi));
+        }
+        let mut check = || match r {
             Ok(rep) => {
                 if bad_output(det, &rep) {
                     bad += 1;
@@ -332,12 +392,16 @@ where
                 b.w2 += f64::from(w2);
             }
             Err(_) => errors += 1,
+        };
+        if phases {
+            phase(sp, lo, hi, checked, i, check);
+        } else {
+            check();
         }
         b.n += 1;
         b.sum += instr;
         b.max = b.max.max(instr);
         if b.n == per_block {
-            deepest = deepest.min(lowest_touched(lo, hi));
             let mean = b.sum / b.n;
             let nf = b.n as f64;
             if blocks == 0 {
@@ -360,13 +424,21 @@ where
                 errors,
                 bad
             );
-            // The print's own stack (float formatting) is not the detector's: repaint.
-            paint(lo, hi);
             blocks += 1;
             b = Block::default();
         }
+        // What the check and the block line wrote is not the detector's: repaint.
+        if !phases {
+            paint(lo, hi);
+        }
     }
-    deepest = deepest.min(lowest_touched(lo, hi));
+    if phases {
+        let [g, s, c] = peaks;
+        hprintln!(
+            "stack phases {}: frame generator {} B (first at frame {}), step {} B (frame {}), output check {} B (frame {})",
+            spec.name, g.bytes, g.frame, s.bytes, s.frame, c.bytes, c.frame
+        );
+    }
     hprintln!(
         "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
         spec.name,
@@ -378,7 +450,11 @@ where
         last,
         worst,
         worst_frame,
-        sp - deepest,
+        if phases {
+            peaks.iter().map(|p| p.bytes).max().unwrap_or(0)
+        } else {
+            sp - deepest
+        },
         size_of::<D>()
     );
 }

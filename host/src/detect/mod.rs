@@ -235,21 +235,21 @@ pub const REGISTRY: &[Entry] = &[
         about: "SMC-PHD TBD with K-means extraction (the baseline of Pei et al. 2019)",
         input: InputKind::PowerCubes,
         default_config: || default_phd(Variant::PhdTbd),
-        run: |r| run_phd(r, "phd-tbd", Variant::PhdTbd),
+        run: |r| run_phd(r, "phd-tbd"),
     },
     Entry {
         name: "pso-phd-kmeans",
         about: "PSO-PHD-TBD, NSGA-II particle swarm, K-means extraction (Pei et al. 2019)",
         input: InputKind::PowerCubes,
         default_config: || default_phd(Variant::PsoKMeans),
-        run: |r| run_phd(r, "pso-phd-kmeans", Variant::PsoKMeans),
+        run: |r| run_phd(r, "pso-phd-kmeans"),
     },
     Entry {
         name: "pso-phd-dbscan",
         about: "PSO-PHD-TBD, NSGA-II particle swarm, DBSCAN extraction (Pei et al. 2019)",
         input: InputKind::PowerCubes,
         default_config: || default_phd(Variant::PsoDbscan),
-        run: |r| run_phd(r, "pso-phd-dbscan", Variant::PsoDbscan),
+        run: |r| run_phd(r, "pso-phd-dbscan"),
     },
     Entry {
         name: "cbmember",
@@ -825,13 +825,9 @@ fn run_classic(req: &Request) -> Result<Outcome> {
     Ok(out)
 }
 
-fn run_phd(req: &Request, name: &'static str, v: Variant) -> Result<Outcome> {
+fn run_phd(req: &Request, name: &'static str) -> Result<Outcome> {
     let t = cpu();
-    let default = match v {
-        Variant::PhdTbd => find_default("phd-tbd"),
-        Variant::PsoKMeans => find_default("pso-phd-kmeans"),
-        Variant::PsoDbscan => find_default("pso-phd-dbscan"),
-    };
+    let default = find_default(name);
     let file: Plain<PhdConfig> = load(req, default, |f: &Plain<PhdConfig>| valid(&f.config))?;
     let cubes = read_real_frames(req.input, 4)?;
     let g = file.config.geometry;

@@ -51,11 +51,40 @@ pub struct Args {
     /// particle, the setting of the README's earlier tables); default: the preset's 512.
     #[arg(long)]
     pub swarm_cap: Option<usize>,
+    /// Algorithms to run, comma-separated: phd-tbd, pso-phd-kmeans, pso-phd-dbscan (the
+    /// paper's three, the default) and phd-tbd-dbscan (PHD-TBD with DBSCAN extraction, an
+    /// ablation).
+    #[arg(long, value_delimiter = ',')]
+    pub variants: Option<Vec<String>>,
+    /// Ablation: the filter's motion noise `q1` (preset 1), finite and > 0.
+    #[arg(long)]
+    pub filter_q1: Option<f64>,
+    /// Ablation: birth mass per component and frame `Pb` (preset 0.02), in (0, 1).
+    #[arg(long)]
+    pub birth_mass: Option<f64>,
+    /// Ablation: birth particles per frame (preset 500), 1 to 4096.
+    #[arg(long)]
+    pub birth_particles: Option<usize>,
+    /// Ablation: particles kept per estimated target (preset 1000), 1 to 8192 (the
+    /// filter holds 8192 particles in all: more are clamped by the filter).
+    #[arg(long)]
+    pub particles_per_target: Option<usize>,
+    /// Ablation: clutter normalisation `lambda_k` of eq. 20 (preset 1), finite and > 0.
+    #[arg(long)]
+    pub clutter_lambda: Option<f64>,
+}
+
+/// What [`Args::effective`] settles: SNRs, runs, algorithms and the scene at each SNR.
+struct Plan {
+    snrs: Vec<f64>,
+    runs: usize,
+    variants: Vec<Variant>,
 }
 
 impl Args {
-    /// The SNRs and runs after the `--quick` defaults, with every argument checked.
-    fn effective(&self) -> Result<(Vec<f64>, usize)> {
+    /// The SNRs, runs and algorithms after the `--quick` defaults, with every argument
+    /// checked.
+    fn effective(&self) -> Result<Plan> {
         let q = self.quick;
         let speed = cli::finite("--birth-pair-speed", self.birth_pair_speed)?;
         anyhow::ensure!(
@@ -71,12 +100,86 @@ impl Args {
             cli::snr_db("--snr-db", s)?;
         }
         let runs = cli::runs("--runs", self.runs.unwrap_or(if q { 2 } else { 100 }))?;
-        Ok((snrs, runs))
+        let variants = match &self.variants {
+            None => Variant::ALL.to_vec(),
+            Some(keys) => {
+                let mut v = Vec::new();
+                for k in keys {
+                    let found = Variant::EVERY.iter().find(|x| x.key() == k.trim());
+                    let Some(&x) = found else {
+                        anyhow::bail!(
+                            "--variants: '{k}' is not one of phd-tbd, pso-phd-kmeans, pso-phd-dbscan, phd-tbd-dbscan"
+                        );
+                    };
+                    anyhow::ensure!(!v.contains(&x), "--variants: '{k}' is given twice");
+                    v.push(x);
+                }
+                anyhow::ensure!(!v.is_empty(), "--variants needs at least one algorithm");
+                v
+            }
+        };
+        let positive = |name: &str, x: Option<f64>| -> Result<()> {
+            if let Some(x) = x {
+                cli::finite(name, x)?;
+                anyhow::ensure!(x > 0.0, "{name} must be > 0, got {x}");
+            }
+            Ok(())
+        };
+        positive("--filter-q1", self.filter_q1)?;
+        positive("--clutter-lambda", self.clutter_lambda)?;
+        if let Some(p) = self.birth_mass {
+            cli::probability("--birth-mass", p)?;
+        }
+        if let Some(n) = self.birth_particles {
+            cli::count("--birth-particles", n, 1..=4096)?;
+        }
+        if let Some(n) = self.particles_per_target {
+            cli::count("--particles-per-target", n, 1..=8192)?;
+        }
+        Ok(Plan {
+            snrs,
+            runs,
+            variants,
+        })
+    }
+
+    /// The preset at `snr` with this run's options.
+    fn scene(&self, snr: f64) -> SixTargets {
+        let mut sc = SixTargets::new(snr);
+        sc.birth_pair_max_speed = self.birth_pair_speed;
+        if let Some(cap) = self.swarm_cap {
+            sc.swarm_cap = cap;
+        }
+        if let Some(q) = self.filter_q1 {
+            sc.filter_q_motion = q;
+        }
+        if let Some(p) = self.birth_mass {
+            sc.p_birth = p;
+        }
+        if let Some(n) = self.birth_particles {
+            sc.birth_particles = n;
+        }
+        if let Some(n) = self.particles_per_target {
+            sc.particles_per_target = n;
+        }
+        if let Some(l) = self.clutter_lambda {
+            sc.clutter_lambda = l;
+        }
+        sc
     }
 
     /// Checks every argument (one-line errors naming the argument) before any run.
     pub fn validate(&self) -> Result<()> {
-        self.effective().map(|_| ())
+        let plan = self.effective()?;
+        // The filter's own validation, once per SNR, before any run.
+        for &snr in &plan.snrs {
+            let sc = self.scene(snr);
+            for &v in &plan.variants {
+                HostFilter::new(sc.config(v), 0)
+                    .map_err(|e| anyhow::anyhow!("the options give an invalid filter: {e}"))?;
+            }
+        }
+        Ok(())
     }
 }
 
@@ -90,6 +193,7 @@ const PAPER: [(f64, [f64; 7]); 3] = [
 /// One run of one variant.
 #[derive(Debug, Clone)]
 struct RunResult {
+    /// `N_hat` per frame.
     counts: Vec<usize>,
     ospa: Vec<f64>,
     seconds: f64,
@@ -104,6 +208,8 @@ struct FrameRow {
     true_count: usize,
     mean_count: f64,
     std_count: f64,
+    /// Mean over runs of `|N_hat - N_true|`.
+    mean_abs_count_error: f64,
     mean_ospa: f64,
 }
 
@@ -115,16 +221,26 @@ struct SummaryRow {
     runs: usize,
     mean_std_count: f64,
     mean_ospa_m: f64,
+    /// Mean over frames and runs of `|N_hat - N_true|`.
+    mean_abs_count_error: f64,
+    /// Frames where every target is alive (the most true targets; frames 20-28 of the
+    /// preset): mean `N_hat` and mean OSPA.
+    all_alive_mean_count: f64,
+    /// See [`SummaryRow::all_alive_mean_count`].
+    all_alive_mean_ospa_m: f64,
     seconds_per_run: f64,
     ms_per_frame: f64,
 }
 
-fn one_run(sc: &SixTargets, seed_rng: &mut Rng) -> Result<Vec<RunResult>> {
+fn one_run(sc: &SixTargets, variants: &[Variant], seed_rng: &mut Rng) -> Result<Vec<RunResult>> {
     let mut truth_rng = seed_rng.fork(1);
     let mut cube_rng = seed_rng.fork(2);
     let truth = sc.truth(&mut truth_rng);
     let mut filters = Vec::new();
-    for (i, &v) in Variant::ALL.iter().enumerate() {
+    for &v in variants {
+        // Each algorithm's filter seed depends on the algorithm only (the paper's three
+        // keep the seeds of earlier runs whatever `--variants` selects).
+        let i = Variant::EVERY.iter().position(|&x| x == v).unwrap_or(0);
         let seed = seed_rng.fork(10 + i as u64).next_u64();
         filters.push(Box::new(
             HostFilter::new(sc.config(v), seed).map_err(|e| anyhow::anyhow!("{e}"))?,
@@ -136,7 +252,7 @@ fn one_run(sc: &SixTargets, seed_rng: &mut Rng) -> Result<Vec<RunResult>> {
             ospa: Vec::new(),
             seconds: 0.0,
         };
-        3
+        variants.len()
     ];
     let mut cube = Vec::new();
     let (c, p) = sc.ospa;
@@ -168,7 +284,12 @@ fn mean_std(v: &[f64]) -> (f64, f64) {
 
 /// Runs the reproduction.
 pub fn run(args: &Args) -> Result<()> {
-    let (snrs, runs) = args.effective()?;
+    args.validate()?;
+    let Plan {
+        snrs,
+        runs,
+        variants,
+    } = args.effective()?;
     cli::out_dir(&args.out)?;
     // The host filter holds ~5 MB of fixed arrays: run trials on threads with big stacks.
     let pool = rayon::ThreadPoolBuilder::new()
@@ -178,15 +299,11 @@ pub fn run(args: &Args) -> Result<()> {
     let mut frames_csv = Vec::new();
     let mut summary = Vec::new();
     for &snr in &snrs {
-        let mut sc = SixTargets::new(snr);
-        sc.birth_pair_max_speed = args.birth_pair_speed;
-        if let Some(cap) = args.swarm_cap {
-            sc.swarm_cap = cap;
-        }
+        let sc = args.scene(snr);
         let label = format!("phd {snr} dB");
         let seed = args.seed ^ (snr * 1000.0) as u64;
         let all: Vec<Result<Vec<RunResult>>> =
-            pool.install(|| run_trials(seed, runs, &label, |_, rng| one_run(&sc, rng)));
+            pool.install(|| run_trials(seed, runs, &label, |_, rng| one_run(&sc, &variants, rng)));
         let all: Vec<Vec<RunResult>> = all.into_iter().collect::<Result<_>>()?;
         let truth_counts: Vec<usize> = (1..=sc.frames)
             .map(|k| {
@@ -206,9 +323,12 @@ pub fn run(args: &Args) -> Result<()> {
         }];
         let mut std_series = Vec::new();
         let mut ospa_series = Vec::new();
-        for (vi, v) in Variant::ALL.iter().enumerate() {
+        let most = truth_counts.iter().copied().max().unwrap_or(0);
+        for (vi, v) in variants.iter().enumerate() {
             let mut stds = Vec::new();
             let mut ospas = Vec::new();
+            let mut errors = Vec::new();
+            let (mut alive_count, mut alive_ospa, mut alive_frames) = (0.0, 0.0, 0usize);
             let mut cs = Vec::new();
             let mut ss = Vec::new();
             let mut os = Vec::new();
@@ -217,8 +337,19 @@ pub fn run(args: &Args) -> Result<()> {
                 let o: Vec<f64> = all.iter().map(|r| r[vi].ospa[k]).collect();
                 let (mc, sdc) = mean_std(&counts);
                 let (mo, _) = mean_std(&o);
+                let err: Vec<f64> = counts
+                    .iter()
+                    .map(|&c| (c - truth_counts[k] as f64).abs())
+                    .collect();
+                let (me, _) = mean_std(&err);
+                if truth_counts[k] == most {
+                    alive_count += mc;
+                    alive_ospa += mo;
+                    alive_frames += 1;
+                }
                 stds.push(sdc);
                 ospas.push(mo);
+                errors.push(me);
                 cs.push(((k + 1) as f64, mc));
                 ss.push(((k + 1) as f64, sdc));
                 os.push(((k + 1) as f64, mo));
@@ -229,6 +360,7 @@ pub fn run(args: &Args) -> Result<()> {
                     true_count: truth_counts[k],
                     mean_count: mc,
                     std_count: sdc,
+                    mean_abs_count_error: me,
                     mean_ospa: mo,
                 });
             }
@@ -240,6 +372,9 @@ pub fn run(args: &Args) -> Result<()> {
                 runs,
                 mean_std_count: mean_std(&stds).0,
                 mean_ospa_m: mean_std(&ospas).0,
+                mean_abs_count_error: mean_std(&errors).0,
+                all_alive_mean_count: alive_count / alive_frames.max(1) as f64,
+                all_alive_mean_ospa_m: alive_ospa / alive_frames.max(1) as f64,
                 seconds_per_run: ms,
                 ms_per_frame: 1e3 * ms / sc.frames as f64,
             });
@@ -295,7 +430,7 @@ fn table(summary: &[SummaryRow]) -> String {
         let (p_std, p_ospa, p_time) = match (paper, s.variant) {
             (Some(p), "PHD-TBD") => (Some(p[0]), Some(p[2]), Some(p[5])),
             (Some(p), "PSO-PHD-TBD (K-means)") => (Some(p[1]), Some(p[3]), None),
-            (Some(p), _) => (Some(p[1]), Some(p[4]), Some(p[6])),
+            (Some(p), "PSO-PHD-TBD (DBSCAN)") => (Some(p[1]), Some(p[4]), Some(p[6])),
             _ => (None, None, None),
         };
         rows.push(vec![
@@ -306,6 +441,9 @@ fn table(summary: &[SummaryRow]) -> String {
             io::fmt_opt(p_std, 2),
             format!("{:.2}", s.mean_ospa_m),
             io::fmt_opt(p_ospa, 2),
+            format!("{:.2}", s.mean_abs_count_error),
+            format!("{:.2}", s.all_alive_mean_count),
+            format!("{:.2}", s.all_alive_mean_ospa_m),
             format!("{:.3}", s.seconds_per_run),
             io::fmt_opt(p_time, 2),
         ]);
@@ -319,6 +457,9 @@ fn table(summary: &[SummaryRow]) -> String {
             "paper T2",
             "mean OSPA m (ours)",
             "paper T3",
+            "mean abs count error",
+            "count, all alive",
+            "OSPA m, all alive",
             "s per 40-frame run (ours, 1 core)",
             "paper T4 (MATLAB)",
         ],

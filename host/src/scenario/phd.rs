@@ -137,6 +137,8 @@ pub struct SixTargets {
     /// At most this many particles move in the swarm per frame (`PsoConfig::max_members`,
     /// 512 by default; `faint reproduce psophd --swarm-cap`, 0 = all gated particles).
     pub swarm_cap: usize,
+    /// Clutter normalisation `lambda_k` of eq. 20 (1, see the module doc).
+    pub clutter_lambda: f64,
     /// Targets.
     pub targets: Vec<TargetSpec>,
     /// DBSCAN radius `E` (m) and density threshold `Th_min`.
@@ -175,6 +177,7 @@ impl SixTargets {
             birth_particles: 500,
             birth_pair_max_speed: 0.0,
             swarm_cap: PsoConfig::paper().max_members,
+            clutter_lambda: 1.0,
             targets: TABLE1.to_vec(),
             dbscan: (5.0, 10),
             ospa: (50.0, 2.0),
@@ -327,10 +330,10 @@ impl SixTargets {
             },
             particles_per_target: self.particles_per_target,
             min_particles: self.birth_particles,
-            clutter_lambda: 1.0,
+            clutter_lambda: self.clutter_lambda as f32,
             merge_adjacent_cells: true,
             pso: match variant {
-                Variant::PhdTbd => None,
+                Variant::PhdTbd | Variant::PhdDbscan => None,
                 _ => Some(PsoConfig {
                     max_members: if self.swarm_cap == 0 {
                         usize::MAX
@@ -341,7 +344,7 @@ impl SixTargets {
                 }),
             },
             extractor: match variant {
-                Variant::PsoDbscan => Extractor::Dbscan(DbscanParams {
+                Variant::PsoDbscan | Variant::PhdDbscan => Extractor::Dbscan(DbscanParams {
                     eps: self.dbscan.0 as f32,
                     min_pts: self.dbscan.1,
                 }),
@@ -363,11 +366,21 @@ pub enum Variant {
     PsoKMeans,
     /// PSO-PHD-TBD with DBSCAN extraction (the paper's proposal).
     PsoDbscan,
+    /// SMC-PHD TBD without PSO, DBSCAN extraction: not in the paper, an ablation that
+    /// separates the swarm's gain from the extractor's.
+    PhdDbscan,
 }
 
 impl Variant {
-    /// All three, in the paper's order.
+    /// The paper's three, in its order.
     pub const ALL: [Variant; 3] = [Variant::PhdTbd, Variant::PsoKMeans, Variant::PsoDbscan];
+    /// The paper's three and the ablation.
+    pub const EVERY: [Variant; 4] = [
+        Variant::PhdTbd,
+        Variant::PsoKMeans,
+        Variant::PsoDbscan,
+        Variant::PhdDbscan,
+    ];
 
     /// Display name.
     pub fn name(self) -> &'static str {
@@ -375,6 +388,18 @@ impl Variant {
             Variant::PhdTbd => "PHD-TBD",
             Variant::PsoKMeans => "PSO-PHD-TBD (K-means)",
             Variant::PsoDbscan => "PSO-PHD-TBD (DBSCAN)",
+            Variant::PhdDbscan => "PHD-TBD (DBSCAN)",
+        }
+    }
+
+    /// Command-line key (`faint reproduce phd --variants`): the `faint detect` name of
+    /// the paper's three, `phd-tbd-dbscan` for the ablation.
+    pub fn key(self) -> &'static str {
+        match self {
+            Variant::PhdTbd => "phd-tbd",
+            Variant::PsoKMeans => "pso-phd-kmeans",
+            Variant::PsoDbscan => "pso-phd-dbscan",
+            Variant::PhdDbscan => "phd-tbd-dbscan",
         }
     }
 }

@@ -162,11 +162,21 @@ impl ModelConfig {
 
     /// Validates and builds the model.
     pub fn build(&self) -> Result<Model> {
+        self.build_reusing(None)
+    }
+
+    /// [`ModelConfig::build`], reusing the response table of `old` when it was built for
+    /// the same bins, sample interval and window ([`DopplerModel::new_reusing`]; same
+    /// result, without the table's cost).
+    pub fn build_reusing(&self, old: Option<&DopplerModel>) -> Result<Model> {
         self.prior.validate()?;
         if !(0.0..=1.0).contains(&self.initial_existence) {
             return Err(Error::InvalidConfig("initial existence probability"));
         }
-        let obs = DopplerModel::new(self.bins, self.ts, self.window)?;
+        let obs = match old {
+            Some(old) => DopplerModel::new_reusing(self.bins, self.ts, self.window, old)?,
+            None => DopplerModel::new(self.bins, self.ts, self.window)?,
+        };
         let motion = Motion {
             dt: obs.frame_time(),
             accel_std: self.accel_std,

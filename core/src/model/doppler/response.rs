@@ -115,12 +115,7 @@ pub struct DopplerModel {
 impl DopplerModel {
     /// Builds the table for `m` bins (`SPAN <= m <= MAX_BINS`) and sample interval `ts`.
     pub fn new(m: usize, ts: f32, window: Window) -> Result<Self> {
-        if !(SPAN..=MAX_BINS).contains(&m) {
-            return Err(Error::InvalidConfig("bins per frame (5..=64)"));
-        }
-        if !(ts.is_finite() && ts > 0.0) {
-            return Err(Error::InvalidConfig("sample interval ts"));
-        }
+        Self::check(m, ts)?;
         // The window's coefficients once, not once per table point (same bits).
         let mut w = [0.0f64; MAX_BINS];
         for (n, c) in w.iter_mut().enumerate().take(m) {
@@ -189,6 +184,30 @@ impl DopplerModel {
     /// Sample interval `ts` (s).
     pub fn ts(&self) -> f32 {
         self.ts
+    }
+
+    /// The errors of [`DopplerModel::new`] for `m` bins and sample interval `ts`.
+    fn check(m: usize, ts: f32) -> Result<()> {
+        if !(SPAN..=MAX_BINS).contains(&m) {
+            return Err(Error::InvalidConfig("bins per frame (5..=64)"));
+        }
+        if !(ts.is_finite() && ts > 0.0) {
+            return Err(Error::InvalidConfig("sample interval ts"));
+        }
+        Ok(())
+    }
+
+    /// [`DopplerModel::new`], or a copy of `old` when `old` was built for the same `m`,
+    /// `ts` (same bits) and window: the table depends on nothing else, and building it
+    /// costs `641 m` double-precision `sincos` (a reconfiguration that keeps the frame
+    /// format skips them).
+    pub fn new_reusing(m: usize, ts: f32, window: Window, old: &DopplerModel) -> Result<Self> {
+        Self::check(m, ts)?;
+        if old.m == m && old.ts.to_bits() == ts.to_bits() && old.window == window {
+            Ok(old.clone())
+        } else {
+            Self::new(m, ts, window)
+        }
     }
 
     /// Frame time `dT = m ts` (s).
