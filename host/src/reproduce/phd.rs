@@ -223,8 +223,8 @@ struct SummaryRow {
     mean_ospa_m: f64,
     /// Mean over frames and runs of `|N_hat - N_true|`.
     mean_abs_count_error: f64,
-    /// Frames where every target is alive (the most true targets; frames 20-28 of the
-    /// preset): mean `N_hat` and mean OSPA.
+    /// Frames where every target is alive (the most true targets; frames 17-29 of the
+    /// preset, all six alive): mean `N_hat` and mean OSPA.
     all_alive_mean_count: f64,
     /// See [`SummaryRow::all_alive_mean_count`].
     all_alive_mean_ospa_m: f64,
