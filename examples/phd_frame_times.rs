@@ -41,6 +41,7 @@ fn run() {
             Variant::PhdTbd => "phd",
             Variant::PsoKMeans => "kmeans",
             Variant::PsoDbscan => "dbscan",
+            Variant::PhdDbscan => "phd-dbscan",
         };
         if which.as_deref().is_some_and(|w| w != tag) {
             continue;
