@@ -145,26 +145,20 @@ impl Args {
 
     /// The preset at `snr` with this run's options.
     fn scene(&self, snr: f64) -> SixTargets {
+        /// `*field = value` when the option was given.
+        fn set<T: Copy>(field: &mut T, value: Option<T>) {
+            if let Some(v) = value {
+                *field = v;
+            }
+        }
         let mut sc = SixTargets::new(snr);
         sc.birth_pair_max_speed = self.birth_pair_speed;
-        if let Some(cap) = self.swarm_cap {
-            sc.swarm_cap = cap;
-        }
-        if let Some(q) = self.filter_q1 {
-            sc.filter_q_motion = q;
-        }
-        if let Some(p) = self.birth_mass {
-            sc.p_birth = p;
-        }
-        if let Some(n) = self.birth_particles {
-            sc.birth_particles = n;
-        }
-        if let Some(n) = self.particles_per_target {
-            sc.particles_per_target = n;
-        }
-        if let Some(l) = self.clutter_lambda {
-            sc.clutter_lambda = l;
-        }
+        set(&mut sc.swarm_cap, self.swarm_cap);
+        set(&mut sc.filter_q_motion, self.filter_q1);
+        set(&mut sc.p_birth, self.birth_mass);
+        set(&mut sc.birth_particles, self.birth_particles);
+        set(&mut sc.particles_per_target, self.particles_per_target);
+        set(&mut sc.clutter_lambda, self.clutter_lambda);
         sc
     }
 
