@@ -1,5 +1,5 @@
 //! Per-frame cost of PHD-TBD, PSO-PHD-TBD (K-means) and PSO-PHD-TBD (DBSCAN) on the
-//! `six-targets` preset at 9 dB (1000 particles per target, 500 births, 1.9 M cells),
+//! `six-targets` preset at 9 dB (1000 particles per target, 1000 births, 1.9 M cells),
 //! measured on frame 21 (six targets alive) from the state reached after 20 frames.
 //! Plus DBSCAN alone on the resampled particles of that frame.
 

@@ -7,10 +7,10 @@
 use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint::core::detect::mht::censoring::Censor;
-use faint::core::detect::mht::{ClassicHoughConfig, Geometry, MhtConfig};
+use faint::core::detect::mht::{ClassicHoughConfig, Geometry, MhtConfig, MAX_DRHO_MIN};
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint::core::detect::phd::{Dbscan, DbscanParams, Extractor, MAX_GENERATIONS};
+use faint::core::detect::phd::{Dbscan, DbscanParams, Extractor, MAX_GENERATIONS, MAX_INTENSITY};
 use faint::core::detect::{Detector, Validate};
 use faint::core::model::doppler::{check_frame, estimate_noise_variance};
 use faint::core::model::plot::Plot;
@@ -18,6 +18,7 @@ use faint::core::rng::Rng;
 use faint::core::{Complex32, Error};
 use faint::host::reliability::check_outputs;
 use faint::host::reliability::targets::small_phd;
+use faint::host::reproduce::mht::Mht;
 use faint::host::scenario::phd::{HostFilter, Variant};
 
 /// Runs `f` on a thread with a 256 MB stack (the host filters are large values).
@@ -405,4 +406,136 @@ fn censoring_with_a_gate_wider_than_the_area_is_bounded() {
     assert_eq!(last.chains, 0);
     assert!(last.chain_overflow > 0, "the node budget never engaged");
     assert!(NODE_BUDGET_PER_PLOT * (P as u32) < 256 + 1024 + 4096 + 16384);
+}
+
+#[test]
+fn mht_rho_floor_near_f32_max_is_rejected_and_the_grid_is_finite() {
+    // Coverage-guided finding: `drho_min = 3e38` validated, and a period whose plots sit
+    // at one point took the floor as the rho half-range: the cell `2 rho_max / R` was inf.
+    let mut c = MhtConfig::sea_clutter();
+    c.drho_min = 3e38;
+    assert_eq!(c.validate(), Err(Error::InvalidConfig("drho_min")));
+    c.drho_min = f32::INFINITY;
+    assert!(c.validate().is_err());
+    // The largest accepted floor, on a period of plots at one point (degenerate geometry).
+    c.drho_min = MAX_DRHO_MIN;
+    c.n_scans = 4;
+    c.gamma1 = 3;
+    big_stack(move || {
+        let mut det = Box::new(Mht::new(c).unwrap());
+        let scan = [Plot::new(10.0, 10.0, 1.0); 3];
+        let mut periods = 0;
+        for _ in 0..8 {
+            let r = det.step(&scan[..]).unwrap();
+            assert_eq!(check_outputs(det.as_ref(), &r), None);
+            if let Some(p) = r.detection {
+                assert!(p.drho.is_finite() && p.drho > 0.0, "{p:?}");
+                periods += 1;
+            }
+        }
+        assert_eq!(periods, 2);
+    });
+    // The public grid caps any half-range so its cell stays finite.
+    for r in [3e38, f32::MAX, f32::INFINITY] {
+        let g = Geometry::<64, 16>::new(0.0, 0.0, r);
+        assert!(g.drho().is_finite() && g.rho_max().is_finite(), "{r}");
+    }
+}
+
+#[test]
+fn phd_intensities_past_the_cap_are_rejected_and_estimates_stay_finite() {
+    // Coverage-guided finding: a birth intensity window `[11.9, 3e38]` validated, and the
+    // first frame's K-means estimate summed two intensities near 3e38: inf.
+    big_stack(|| {
+        let mut c = small_phd(Variant::PhdTbd);
+        c.birth.intensity = [11.9, 3e38];
+        assert!(c.validate().is_err());
+        let mut m = small_phd(Variant::PhdTbd);
+        m.min_intensity = 2e28;
+        assert!(m.validate().is_err());
+        // At the cap, with the intensity noise pushing past it every frame.
+        c.birth.intensity = [MAX_INTENSITY; 2];
+        c.q_intensity = 1e38;
+        let mut det = Box::new(HostFilter::new(c, 0).unwrap());
+        let mut rng = Rng::seed_from_u64(7);
+        let n = c.geometry.n_range * c.geometry.n_doppler * c.geometry.n_azimuth;
+        let frames: Vec<Vec<f32>> = (0..6)
+            .map(|_| (0..n).map(|_| 1e30 * rng.exponential()).collect())
+            .collect();
+        clean(det.as_mut(), &frames);
+    });
+}
+
+#[test]
+fn non_dominated_sort_with_nan_values_terminates() {
+    // Coverage-guided finding (PSO-PHD-TBD with DBSCAN, SIGSEGV after 128 369 inputs, no
+    // libFuzzer report): a swarm position that overflowed gave a NaN fitness, the pivot of
+    // the divide-and-conquer sort then separated nothing, and `helper_a` recursed on the
+    // same list until the stack overflowed. Any value now gives ranks.
+    use faint::core::detect::phd::ndsort::{rank_sorted, Workspace};
+    big_stack(|| {
+        let mut rng = Rng::seed_from_u64(79);
+        for case in 0..200 {
+            let n = 1 + rng.below(400) as usize;
+            let m = 3 + rng.below(6) as usize;
+            let nan_share = [1.0f32, 0.5, 0.05][case % 3];
+            let f: Vec<[f32; 8]> = (0..n)
+                .map(|_| {
+                    core::array::from_fn(|_| {
+                        if rng.uniform() < nan_share {
+                            f32::NAN
+                        } else {
+                            (rng.uniform() * 6.0).floor()
+                        }
+                    })
+                })
+                .collect();
+            let (mut rank, mut work, mut scratch, mut ord1, mut fen) = (
+                vec![0u32; n],
+                vec![0u32; n],
+                vec![0u32; n],
+                vec![0u32; n],
+                vec![0u32; n],
+            );
+            let ws = Workspace {
+                work: &mut work,
+                scratch: &mut scratch,
+                order1: &mut ord1,
+                fenwick: &mut fen,
+            };
+            let fronts = rank_sorted(n, m, |p, j| f[p][j], &mut rank, ws);
+            assert!(
+                fronts <= n && rank.iter().all(|&r| (r as usize) < n),
+                "case {case}"
+            );
+        }
+    });
+}
+
+#[test]
+fn swarm_steps_that_overflow_positions_keep_outputs_finite() {
+    // The swarm configurations that reach non-finite positions (the route to the NaN
+    // fitness above): a mutation half-width whose draw `U[-m, m]` overflows is rejected;
+    // huge but accepted inertia and acceleration factors run with finite outputs (a
+    // particle pushed out of the cube dies in the update).
+    big_stack(|| {
+        let mut c = small_phd(Variant::PsoDbscan);
+        c.pso.as_mut().unwrap().mutation = 3e38;
+        assert!(c.validate().is_err());
+        let mut rng = Rng::seed_from_u64(8);
+        let base = small_phd(Variant::PsoDbscan);
+        let n = base.geometry.n_range * base.geometry.n_doppler * base.geometry.n_azimuth;
+        let frames: Vec<Vec<f32>> = (0..6)
+            .map(|_| (0..n).map(|_| 2.0 * rng.exponential()).collect())
+            .collect();
+        for (inertia, c1, mutation) in [(3e38, 1.0, 2.0), (1.0, 3e38, 2.0), (2.0, 2.0, 8e37)] {
+            let mut c = small_phd(Variant::PsoDbscan);
+            let p = c.pso.as_mut().unwrap();
+            (p.inertia, p.c1, p.c2, p.mutation) = (inertia, c1, c1, mutation);
+            p.max_generations = 1000;
+            p.threshold = 2.0;
+            let mut det = Box::new(HostFilter::new(c, 0).unwrap());
+            clean(det.as_mut(), &frames);
+        }
+    });
 }

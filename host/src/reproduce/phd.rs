@@ -62,7 +62,7 @@ pub struct Args {
     /// Ablation: birth mass per component and frame `Pb` (preset 0.02), in (0, 1).
     #[arg(long)]
     pub birth_mass: Option<f64>,
-    /// Ablation: birth particles per frame (preset 500), 1 to 4096.
+    /// Ablation: birth particles per frame (preset 1000), 1 to 4096.
     #[arg(long)]
     pub birth_particles: Option<usize>,
     /// Ablation: particles kept per estimated target (preset 1000), 1 to 8192 (the

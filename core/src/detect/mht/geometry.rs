@@ -71,7 +71,8 @@ impl<const R: usize, const A: usize> Geometry<R, A> {
     /// A grid with origin `(x0, y0)` covering `rho in [-rho_max, rho_max]`.
     ///
     /// `rho_max` is floored at `1e-3` m (degenerate geometry: all points at the origin
-    /// map to the middle rho cell) and non-finite inputs fall back to origin 0 and the floor.
+    /// map to the middle rho cell), capped at `f32::MAX / 4`; a non-finite origin falls
+    /// back to 0 and a NaN `rho_max` to the floor.
     pub fn new(x0: f32, y0: f32, rho_max: f32) -> Self {
         let () = Self::SHAPE;
         let mut cos = [0.0f32; A];
@@ -86,8 +87,10 @@ impl<const R: usize, const A: usize> Geometry<R, A> {
             sin_q[a] = math::round(sin[a] * TRIG_Q) as i32;
         }
         let fin = |v: f32| if v.is_finite() { v } else { 0.0 };
-        let rho_max = if rho_max.is_finite() && rho_max > 1e-3 {
-            rho_max
+        // Clamped into `[1e-3, f32::MAX / 4]` (NaN to the floor): `2 rho_max` and the
+        // rho cell stay finite for any input.
+        let rho_max = if rho_max > 1e-3 {
+            rho_max.min(f32::MAX / 4.0)
         } else {
             1e-3
         };

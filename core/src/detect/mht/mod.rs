@@ -103,6 +103,10 @@ pub fn in_area(p: &Plot, area: [f32; 4]) -> bool {
 /// `sqrt(hx^2 + hy^2)` of eq. 7 then stays finite (`2 (1e18)^2 < f32::MAX`).
 pub const MAX_COORDINATE: f32 = 1e18;
 
+/// Largest [`MhtConfig::drho_min`] (m): above the diagonal of any valid area
+/// (`2 sqrt(2) MAX_COORDINATE`), far below where `2 rho_max` overflows `f32`.
+pub const MAX_DRHO_MIN: f32 = 4.0 * MAX_COORDINATE;
+
 pub(crate) fn validate_area(area: [f32; 4]) -> Result<()> {
     let inside = |v: &f32| v.abs() <= MAX_COORDINATE; // false for NaN
     if !area.iter().all(inside) || area[1] <= area[0] || area[3] <= area[2] {
@@ -146,7 +150,9 @@ pub struct MhtConfig {
     /// `confirm_frac * gamma_1`: the paper's "correct the detections with the association
     /// results"; it rejects peaks built from pieces of unrelated chains and tracks.
     pub confirm_frac: f32,
-    /// Smallest DMHT rho half-range (m) (degenerate geometry).
+    /// Smallest DMHT rho half-range (m) (degenerate geometry), in `(0, 4e18]`: the upper
+    /// end is above the diagonal of the largest valid area (`2.9e18` m), so every
+    /// geometry an area allows is reachable, and keeps the rho cell `2 rho_max / R` finite.
     pub drho_min: f32,
     /// Sequential extraction: a peak after the first confirmed track is confirmed only if
     /// its cell's binary-integration count, without the plots its track shares with the
@@ -208,7 +214,7 @@ impl Validate for MhtConfig {
         if !(self.confirm_frac.is_finite() && (0.0..=1.0).contains(&self.confirm_frac)) {
             return Err(Error::InvalidConfig("confirm_frac"));
         }
-        if !(self.drho_min.is_finite() && self.drho_min > 0.0) {
+        if !(self.drho_min > 0.0 && self.drho_min <= MAX_DRHO_MIN) {
             return Err(Error::InvalidConfig("drho_min"));
         }
         Ok(())

@@ -49,8 +49,9 @@ pub struct Workspace<'a> {
 /// Ranks (front index, 0 = non-dominated) of `n` solutions given in lexicographically
 /// descending order of their objective vectors `val(p, 0..k)` (position 0 first).
 ///
-/// Writes `rank[..n]` (by position) and returns the number of fronts. Values must be
-/// finite.
+/// Writes `rank[..n]` (by position) and returns the number of fronts. Values should be
+/// finite; a NaN gives some ranks, never an unbounded recursion (a split that separates
+/// nothing falls back to comparing all pairs).
 pub fn rank_sorted<V: Fn(usize, usize) -> f32>(
     n: usize,
     k: usize,
@@ -166,20 +167,27 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
         }
     }
 
+    /// Ranks of `h` raised from `l` by comparing all pairs; `l == h` (one list, in
+    /// position order) ranks within it: every earlier solution's rank is final when used.
+    fn all_pairs(&mut self, l: &[u32], h: &[u32], k: usize) {
+        for (i, &hh) in h.iter().enumerate() {
+            let same = core::ptr::eq(l, h);
+            let from = if same { l.get(..i).unwrap_or(&[]) } else { l };
+            for &ll in from {
+                if self.weakly(ll, hh, k) {
+                    self.raise(hh, ll);
+                }
+            }
+        }
+    }
+
     fn helper_a(&mut self, s: &mut [u32], k: usize) {
         let n = s.len();
         if n < 2 {
             return;
         }
         if k <= 1 || n <= SMALL {
-            // Position order: every earlier solution's rank is final when used.
-            for i in 1..n {
-                for j in 0..i {
-                    if self.weakly(s[j], s[i], k) {
-                        self.raise(s[i], s[j]);
-                    }
-                }
-            }
+            self.all_pairs(s, s, k);
             return;
         }
         if k == 2 {
@@ -194,6 +202,13 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
         }
         let (p, ge) = self.pivot(s, &[], o, mx);
         let nb = self.partition(s, o, p, ge);
+        if nb == 0 || nb >= n {
+            // No split (only with NaN values: a finite pivot always separates the
+            // maximum from a sampled value): the stable partition left `s` as it was;
+            // all pairs, so the recursion always shrinks.
+            self.all_pairs(s, s, k);
+            return;
+        }
         if let Some((b, w)) = s.split_at_mut_checked(nb) {
             self.helper_a(b, k);
             self.helper_b(b, w, k - 1);
@@ -207,13 +222,7 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
             return;
         }
         if k <= 1 || l.len() * h.len() <= SMALL * SMALL {
-            for &hh in h.iter() {
-                for &ll in l.iter() {
-                    if self.weakly(ll, hh, k) {
-                        self.raise(hh, ll);
-                    }
-                }
-            }
+            self.all_pairs(l, h, k);
             return;
         }
         if k == 2 {
@@ -233,6 +242,11 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
         let (p, ge) = self.pivot(l, h, o, if mxl > mxh { mxl } else { mxh });
         let nl = self.partition(l, o, p, ge);
         let nh = self.partition(h, o, p, ge);
+        if (nl == 0 && nh == 0) || (nl >= l.len() && nh >= h.len()) {
+            // No split (NaN values only): both lists are unchanged; all pairs.
+            self.all_pairs(l, h, k);
+            return;
+        }
         if let (Some((l1, l2)), Some((h1, h2))) =
             (l.split_at_mut_checked(nl), h.split_at_mut_checked(nh))
         {

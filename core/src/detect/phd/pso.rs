@@ -289,7 +289,7 @@ pub struct PsoConfig {
     /// A particle joins the swarm if its best single-objective fitness is at least this;
     /// objective values below it are floored to 0.
     pub gate: f32,
-    /// Half width (m) of the uniform mutation increments.
+    /// Half width (m) of the uniform mutation increments, at most `f32::MAX / 4`.
     pub mutation: f32,
     /// Number of measurement-derived points `Z_m` (objectives), at most the capacity `M`.
     pub points: usize,
@@ -452,7 +452,8 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             let dx = p[0] - z[0];
             let dy = p[1] - z[1];
             let a = (dx * dx + dy * dy) * inv_two_s2;
-            let v = if a > cut { 0.0 } else { math::exp(-a) };
+            // NaN (a non-finite position) is below the gate too: fitness is never NaN.
+            let v = if a <= cut { math::exp(-a) } else { 0.0 };
             *f = v;
             total += v;
         }

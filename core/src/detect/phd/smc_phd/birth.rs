@@ -70,7 +70,7 @@ pub struct BirthModel {
     pub particles: usize,
     /// Expected number of births per frame (total birth PHD mass).
     pub mass: f32,
-    /// Birth intensities are `U[lo, hi]`.
+    /// Birth intensities are `U[lo, hi]`, `0 <= lo <= hi <= MAX_INTENSITY`.
     pub intensity: [f32; 2],
 }
 

@@ -39,6 +39,16 @@ use crate::particles::{resample, Scheme};
 use crate::rng::Rng;
 use crate::{Error, Result};
 
+/// Largest particle intensity (target power, in units of the cell power): a cluster's
+/// mean state sums the intensities of up to `N <= u32::MAX` particles, and
+/// `4.3e9 * 1e28 < f32::MAX`. The birth intensities and `min_intensity` must not exceed it,
+/// and the prediction clamps to it (1e28 is an SNR of 280 dB, beyond any receiver).
+pub const MAX_INTENSITY: f32 = 1e28;
+
+/// Largest swarm mutation half-width [`PsoConfig::mutation`] (m): the draw
+/// `U[-m, m] = -m + 2 m u` needs `2 m` finite.
+pub const MAX_MUTATION: f32 = f32::MAX / 4.0;
+
 /// State extractor.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(
@@ -77,7 +87,8 @@ pub struct PhdConfig {
     pub q_motion: f32,
     /// Intensity noise `q2` (variance `q2 T` per frame).
     pub q_intensity: f32,
-    /// Lower clamp of the predicted intensity.
+    /// Lower clamp of the predicted intensity, in `[0, MAX_INTENSITY]` (the upper clamp
+    /// is [`MAX_INTENSITY`]).
     pub min_intensity: f32,
     /// Survival probability `Ps`.
     pub p_survival: f32,
@@ -111,8 +122,11 @@ impl Validate for PhdConfig {
         if !pos(self.dt) {
             return Err(Error::InvalidConfig("dt"));
         }
-        if !nonneg(self.q_motion) || !nonneg(self.q_intensity) || !nonneg(self.min_intensity) {
-            return Err(Error::InvalidConfig("process noise / min_intensity"));
+        if !nonneg(self.q_motion) || !nonneg(self.q_intensity) {
+            return Err(Error::InvalidConfig("process noise"));
+        }
+        if !(self.min_intensity >= 0.0 && self.min_intensity <= MAX_INTENSITY) {
+            return Err(Error::InvalidConfig("min_intensity (0..=1e28)"));
         }
         if !(self.p_survival > 0.0 && self.p_survival <= 1.0) {
             return Err(Error::InvalidConfig("p_survival"));
@@ -147,10 +161,12 @@ impl Validate for PhdConfig {
             return Err(Error::InvalidConfig("birth particles / mass"));
         }
         if !(nonneg(b.intensity[0])
-            && b.intensity[1].is_finite()
+            && b.intensity[1] <= MAX_INTENSITY
             && b.intensity[1] >= b.intensity[0])
         {
-            return Err(Error::InvalidConfig("birth intensity"));
+            return Err(Error::InvalidConfig(
+                "birth intensity (0 <= lo <= hi <= 1e28)",
+            ));
         }
         if self.particles_per_target == 0 || self.min_particles == 0 {
             return Err(Error::InvalidConfig("particles_per_target / min_particles"));
@@ -164,7 +180,7 @@ impl Validate for PhdConfig {
             if p.points == 0
                 || p.max_members == 0
                 || !pos(p.fitness_scale)
-                || !nonneg(p.mutation)
+                || !(p.mutation >= 0.0 && p.mutation <= MAX_MUTATION)
                 || ![p.inertia, p.c1, p.c2, p.step, p.threshold, p.gate]
                     .iter()
                     .all(|v| v.is_finite())
@@ -404,7 +420,9 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                 s[k] += t * s[k + 1] + a * n1;
                 s[k + 1] += b * n1 + cc * n2;
             }
-            s[4] = (s[4] + si * self.rng.normal()).max(c.min_intensity);
+            s[4] = (s[4] + si * self.rng.normal())
+                .max(c.min_intensity)
+                .min(MAX_INTENSITY);
             *w *= c.p_survival;
         }
     }
