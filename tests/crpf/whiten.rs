@@ -90,6 +90,32 @@ fn unwindow_rejects_bad_input() {
     }
 }
 
+proptest::proptest! {
+    #![proptest_config(proptest::test_runner::Config { cases: 2000, ..Default::default() })]
+    /// Arbitrary bits, any length 0..=70, every window: either a typed error with the
+    /// frame unchanged, or a finite frame (the frame check bounds `|z_b| <= 1.9e19`, and
+    /// the transform's gain is at most `m / min w <= 64e6`).
+    #[test]
+    fn unwindow_on_arbitrary_bits_errs_unchanged_or_stays_finite(
+        bits in proptest::collection::vec(proptest::prelude::any::<u32>(), 0..=140),
+        w in 0usize..4,
+    ) {
+        let mut z: Vec<Complex32> = bits
+            .chunks_exact(2)
+            .map(|p| Complex32::new(f32::from_bits(p[0]), f32::from_bits(p[1])))
+            .collect();
+        let window = [Window::Hamming, Window::Rectangular, Window::Hann, Window::Hamming][w];
+        let before: Vec<(u32, u32)> = z.iter().map(|c| (c.re.to_bits(), c.im.to_bits())).collect();
+        match unwindow(&mut z, window) {
+            Err(_) => {
+                let after: Vec<(u32, u32)> = z.iter().map(|c| (c.re.to_bits(), c.im.to_bits())).collect();
+                proptest::prop_assert_eq!(after, before);
+            }
+            Ok(()) => proptest::prop_assert!(z.iter().all(|c| c.re.is_finite() && c.im.is_finite())),
+        }
+    }
+}
+
 /// JOTT given the true per-bin variance on noise-only runs: with independent bins of
 /// the windowed frame its existence drifts up (the correlated bins make its likelihood
 /// overconfident); with the whitened frames and the rectangular response it stays low.

@@ -43,7 +43,7 @@ use faint_core::detect::dp::{
 };
 use faint_core::detect::mht::{ClassicHoughConfig, MhtConfig};
 use faint_core::detect::pf_lrt::PfLrt;
-use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint_core::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd};
 use faint_core::detect::phd::{BirthMode, PhdConfig, SmcPhdTbd};
 use faint_core::detect::Detector;
 use faint_core::model::doppler::Window;
@@ -596,13 +596,15 @@ pub fn crpf_bases() -> Vec<CrpfConfig> {
     v
 }
 
-/// The Gaussian comparators' preset and the other two windows.
+/// The Gaussian comparators' preset, the other two windows and the fixed-share birth
+/// proposal (its share is a leaf the edits reach).
 pub fn gauss_bases() -> Vec<GaussConfig> {
     let mut p = GaussConfig::othr(1.0);
     p.model.bins = DOPPLER_BINS;
-    let mut v = vec![p; 3];
+    let mut v = vec![p; 4];
     v[1].model.window = Window::Rectangular;
     v[2].model.window = Window::Hann;
+    v[3].birth = BirthProposal::FixedShare(0.1);
     v
 }
 
