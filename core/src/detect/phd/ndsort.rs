@@ -170,8 +170,8 @@ impl<V: Fn(usize, usize) -> f32> Ctx<'_, V> {
     /// Ranks of `h` raised from `l` by comparing all pairs; `l == h` (one list, in
     /// position order) ranks within it: every earlier solution's rank is final when used.
     fn all_pairs(&mut self, l: &[u32], h: &[u32], k: usize) {
+        let same = core::ptr::eq(l, h);
         for (i, &hh) in h.iter().enumerate() {
-            let same = core::ptr::eq(l, h);
             let from = if same { l.get(..i).unwrap_or(&[]) } else { l };
             for &ll in from {
                 if self.weakly(ll, hh, k) {
