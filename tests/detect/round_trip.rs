@@ -221,15 +221,10 @@ fn phd_detectors_round_trip() {
     ] {
         let cfg = sc.config(v);
         let cubes = cubes.clone();
-        let want = std::thread::Builder::new()
-            .stack_size(256 << 20)
-            .spawn(move || {
-                let mut f = Box::new(HostFilter::new(cfg, DET_SEED).unwrap());
-                rows_of(f.as_mut(), cubes.iter().map(|c| c.as_slice()))
-            })
-            .unwrap()
-            .join()
-            .unwrap();
+        let want = faint::host::montecarlo::on_worker_stack(move || {
+            let mut f = Box::new(HostFilter::new(cfg, DET_SEED).unwrap());
+            rows_of(f.as_mut(), cubes.iter().map(|c| c.as_slice()))
+        });
         assert!(
             !want.is_empty(),
             "{name}: the first target (frame 5) is estimated by frame 7"
@@ -350,15 +345,10 @@ fn cbmember_detectors_round_trip() {
             ..CbmemberConfig::rotor_uav()
         };
         let maps = maps.clone();
-        let want = std::thread::Builder::new()
-            .stack_size(256 << 20)
-            .spawn(move || {
-                let mut f = Box::new(Cbm::new(cfg, DET_SEED).unwrap());
-                rows_of(f.as_mut(), maps.iter().map(|m| m.as_slice()))
-            })
-            .unwrap()
-            .join()
-            .unwrap();
+        let want = faint::host::montecarlo::on_worker_stack(move || {
+            let mut f = Box::new(Cbm::new(cfg, DET_SEED).unwrap());
+            rows_of(f.as_mut(), maps.iter().map(|m| m.as_slice()))
+        });
         assert_eq!(detect(name, &file, &dir.join(name)), want, "{name}");
     }
     let truth = std::fs::read_to_string(dir.join("maps.truth.csv")).unwrap();

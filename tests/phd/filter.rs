@@ -10,12 +10,7 @@ use faint::host::stats::ospa::ospa;
 
 /// The host filter is ~5 MB of fixed arrays: run on a thread with a big stack.
 fn big_stack(f: impl FnOnce() + Send + 'static) {
-    std::thread::Builder::new()
-        .stack_size(256 << 20)
-        .spawn(f)
-        .unwrap()
-        .join()
-        .unwrap();
+    faint::host::montecarlo::on_worker_stack(f);
 }
 
 #[test]

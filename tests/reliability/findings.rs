@@ -23,12 +23,7 @@ use faint::host::scenario::phd::{HostFilter, Variant};
 
 /// Runs `f` on a thread with a 256 MB stack (the host filters are large values).
 fn big_stack<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
-    std::thread::Builder::new()
-        .stack_size(256 << 20)
-        .spawn(f)
-        .unwrap()
-        .join()
-        .unwrap()
+    faint::host::montecarlo::on_worker_stack(f)
 }
 
 fn noise(rng: &mut Rng, m: usize, s: f32) -> Vec<Complex32> {

@@ -16,12 +16,7 @@ fn names() -> impl Iterator<Item = &'static str> {
 
 /// Runs `f` on a thread with a 256 MB stack (the host filters are large values).
 fn big_stack<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
-    std::thread::Builder::new()
-        .stack_size(256 << 20)
-        .spawn(f)
-        .unwrap()
-        .join()
-        .unwrap()
+    faint::host::montecarlo::on_worker_stack(f)
 }
 
 #[test]

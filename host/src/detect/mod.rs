@@ -19,7 +19,7 @@
 
 use std::path::Path;
 
-use anyhow::{anyhow, bail, ensure, Context, Result};
+use anyhow::{anyhow, bail, ensure, Result};
 use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::cbmember::CbmemberConfig;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
@@ -398,13 +398,9 @@ fn run_cbmember(req: &Request, name: &'static str, model: PointModel) -> Result<
     );
     let read = cpu() - t;
     let cfg = file.config;
-    let mut det = std::thread::Builder::new()
-        .stack_size(256 << 20)
-        .spawn(move || CbmemberHost::new(cfg, 0).map(Box::new))
-        .context("cannot start the filter thread")?
-        .join()
-        .map_err(|_| anyhow!("the filter thread panicked"))?
-        .map_err(|e| anyhow!("{e}"))?;
+    let mut det =
+        crate::montecarlo::on_worker_stack(move || CbmemberHost::new(cfg, 0).map(Box::new))
+            .map_err(|e| anyhow!("{e}"))?;
     det.configure(&cfg, req.seed).map_err(|e| anyhow!("{e}"))?;
     let mut out = drive(
         name,
@@ -841,13 +837,8 @@ fn run_phd(req: &Request, name: &'static str) -> Result<Outcome> {
     );
     let read = cpu() - t;
     let cfg = file.config;
-    // Large filter: built on a thread with a big stack, then boxed.
-    let mut det = std::thread::Builder::new()
-        .stack_size(256 << 20)
-        .spawn(move || HostFilter::new(cfg, 0).map(Box::new))
-        .context("cannot start the filter thread")?
-        .join()
-        .map_err(|_| anyhow!("the filter thread panicked"))?
+    // Large filter: built on a worker stack, then boxed.
+    let mut det = crate::montecarlo::on_worker_stack(move || HostFilter::new(cfg, 0).map(Box::new))
         .map_err(|e| anyhow!("{e}"))?;
     det.configure(&cfg, req.seed).map_err(|e| anyhow!("{e}"))?;
     let mut out = drive(

@@ -107,23 +107,25 @@ pub fn fuzz_all(args: &FuzzArgs) -> Result<Vec<Tally>> {
         }
     }
     let pb = progress_bar("fuzz", items.len());
-    let parts: Vec<Result<(usize, Tally)>> = items
-        .par_iter()
-        .map(|&(d, name, first, cases)| {
-            let opts = Options {
-                seed: args.seed,
-                first,
-                cases,
-                frames_per_case: args.frames_per_case,
-            };
-            let r = match run(name, Job::Fuzz(opts))? {
-                Outcome::Fuzz(t) => (d, t),
-                Outcome::Soak(_) => bail!("internal: a soak outcome from a fuzz job"),
-            };
-            pb.inc(1);
-            Ok(r)
-        })
-        .collect();
+    let parts: Vec<Result<(usize, Tally)>> = crate::montecarlo::pool().install(|| {
+        items
+            .par_iter()
+            .map(|&(d, name, first, cases)| {
+                let opts = Options {
+                    seed: args.seed,
+                    first,
+                    cases,
+                    frames_per_case: args.frames_per_case,
+                };
+                let r = match run(name, Job::Fuzz(opts))? {
+                    Outcome::Fuzz(t) => (d, t),
+                    Outcome::Soak(_) => bail!("internal: a soak outcome from a fuzz job"),
+                };
+                pb.inc(1);
+                Ok(r)
+            })
+            .collect()
+    });
     pb.finish_and_clear();
     let mut out: Vec<Tally> = dets
         .iter()

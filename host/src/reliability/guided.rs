@@ -886,11 +886,7 @@ pub fn finding(name: &str, data: &[u8]) -> anyhow::Result<Option<super::Finding>
     let f = by_name(detector).ok_or_else(|| anyhow::anyhow!("no guided target '{name}'"))?;
     let hex = to_hex(data);
     let data = data.to_vec();
-    let r = std::thread::Builder::new()
-        .stack_size(256 << 20)
-        .spawn(move || super::catch(|| f(&data)))?
-        .join()
-        .map_err(|_| anyhow::anyhow!("the replay thread panicked"))?;
+    let r = crate::montecarlo::on_worker_stack(move || super::catch(|| f(&data)));
     let (kind, message, config) = match r {
         Ok(Ok(_)) => return Ok(None),
         Ok(Err(e)) => (e.kind, e.message, e.config),

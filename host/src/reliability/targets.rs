@@ -5,9 +5,7 @@
 //! extent instead of 142 x 150 x 90) so that a case costs milliseconds; the arithmetic
 //! the campaign probes is the same at any size.
 
-use std::thread;
-
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::cbmember::CbmemberConfig;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
@@ -173,20 +171,6 @@ fn image_reduced(rng: &mut Rng, _c: &DpConfig, mode: Mode) -> Vec<f32> {
     reals(rng, REDUCED_SIDE * REDUCED_SIDE, mode, 1.5, false)
 }
 
-/// Builds two detectors on a thread with a large stack (the host filters are large
-/// values) and runs the campaign there.
-fn on_big_stack<F>(f: F) -> Result<Outcome>
-where
-    F: FnOnce() -> Result<Outcome> + Send + 'static,
-{
-    thread::Builder::new()
-        .stack_size(512 << 20)
-        .spawn(f)
-        .context("cannot start the campaign thread")?
-        .join()
-        .map_err(|_| anyhow!("the campaign thread panicked outside a step"))?
-}
-
 fn pair<D>(
     make: impl Fn() -> std::result::Result<D, faint_core::Error>,
 ) -> Result<(Box<D>, Box<D>)> {
@@ -242,7 +226,8 @@ fn boxed2<D: faint_core::detect::dp::DpTrack + sdp::ZeroValid>(
 pub fn run(name: &str, job: Job) -> Result<Outcome> {
     let name: &'static str = crate::detect::find(name)?.name;
     let reduced = matches!(job, Job::Soak(_, _, Shape::Reduced));
-    on_big_stack(move || {
+    // Two detectors are built by value (the host filters are large): on a worker stack.
+    crate::montecarlo::on_worker_stack(move || {
         let o = &job;
         Ok(match name {
             "crpf" => {

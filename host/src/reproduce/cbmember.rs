@@ -524,10 +524,7 @@ fn fmt_db(x: Option<f64>) -> String {
 /// Runs the reproduction.
 pub fn run(args: &Args) -> Result<()> {
     let e = args.effective()?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .stack_size(64 << 20)
-        .build()
-        .context("thread pool")?;
+    let pool = crate::montecarlo::pool();
     let want = |s: &str| e.sets.iter().any(|x| x == s);
     let d = &args.out;
     cli::out_dir(d)?;
@@ -560,7 +557,7 @@ pub fn run(args: &Args) -> Result<()> {
                 v.extend(parts.iter().filter(|&&p| p != 1500).map(|&p| joint(sc, p)));
                 v
             },
-            &pool,
+            pool,
         )?);
         save(&rows)?;
     }
@@ -578,7 +575,7 @@ pub fn run(args: &Args) -> Result<()> {
                     sc
                 },
                 &|sc| vec![joint(sc, 1500)],
-                &pool,
+                pool,
             )?);
         }
         save(&rows)?;
@@ -596,7 +593,7 @@ pub fn run(args: &Args) -> Result<()> {
                     sc
                 },
                 &|sc| vec![joint(sc, 1500)],
-                &pool,
+                pool,
             )?);
         }
         save(&rows)?;
@@ -613,7 +610,7 @@ pub fn run(args: &Args) -> Result<()> {
                 sc
             },
             &|sc| vec![joint(sc, 1500), doppler(sc, 1500)],
-            &pool,
+            pool,
         )?);
         save(&rows)?;
     }
@@ -633,7 +630,7 @@ pub fn run(args: &Args) -> Result<()> {
                 q.name = "joint 1500 u8 map".into();
                 vec![est, q]
             },
-            &pool,
+            pool,
         )?);
         save(&rows)?;
     }
@@ -654,7 +651,7 @@ pub fn run(args: &Args) -> Result<()> {
                 };
                 vec![narrow(joint(sc, 1500)), narrow(doppler(sc, 1500))]
             },
-            &pool,
+            pool,
         )?);
         save(&rows)?;
     }
@@ -679,7 +676,7 @@ pub fn run(args: &Args) -> Result<()> {
                 f.name = "joint 1500 micro-Doppler known".into();
                 vec![f]
             },
-            &pool,
+            pool,
         )?);
         save(&rows)?;
     }
@@ -702,7 +699,7 @@ pub fn run(args: &Args) -> Result<()> {
                     matched(doppler(sc, 1500)),
                 ]
             },
-            &pool,
+            pool,
         )?);
         save(&rows)?;
     }

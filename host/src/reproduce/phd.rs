@@ -13,7 +13,7 @@ use faint_core::detect::Detector;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use faint_core::rng::Rng;
 use serde::Serialize;
 
@@ -285,11 +285,6 @@ pub fn run(args: &Args) -> Result<()> {
         variants,
     } = args.effective()?;
     cli::out_dir(&args.out)?;
-    // The host filter holds ~5 MB of fixed arrays: run trials on threads with big stacks.
-    let pool = rayon::ThreadPoolBuilder::new()
-        .stack_size(256 << 20)
-        .build()
-        .context("thread pool")?;
     let mut frames_csv = Vec::new();
     let mut summary = Vec::new();
     for &snr in &snrs {
@@ -297,7 +292,7 @@ pub fn run(args: &Args) -> Result<()> {
         let label = format!("phd {snr} dB");
         let seed = args.seed ^ (snr * 1000.0) as u64;
         let all: Vec<Result<Vec<RunResult>>> =
-            pool.install(|| run_trials(seed, runs, &label, |_, rng| one_run(&sc, &variants, rng)));
+            run_trials(seed, runs, &label, |_, rng| one_run(&sc, &variants, rng));
         let all: Vec<Vec<RunResult>> = all.into_iter().collect::<Result<_>>()?;
         let truth_counts: Vec<usize> = (1..=sc.frames)
             .map(|k| {

@@ -35,16 +35,6 @@ pub struct Rate {
     pub samples: usize,
 }
 
-/// Worker stack (the detectors of the check are a few MiB and built on the stack).
-const STACK: usize = 64 << 20;
-
-fn pool() -> Result<rayon::ThreadPool> {
-    rayon::ThreadPoolBuilder::new()
-        .stack_size(STACK)
-        .build()
-        .map_err(|e| anyhow::anyhow!("thread pool: {e}"))
-}
-
 fn noise_frame(rng: &mut Rng, sigma: f32, out: &mut [f32]) {
     for v in out.iter_mut() {
         *v = sigma * rng.normal();
@@ -87,7 +77,7 @@ where
     }
     let lsb = f64::from(cfg.lsb);
     type PerImage = Vec<(f64, usize, f64, BTreeMap<i64, u64>)>;
-    let runs: Vec<Result<PerImage>> = pool()?.install(|| {
+    let runs: Vec<Result<PerImage>> = crate::montecarlo::pool().install(|| {
         run_trials(seed, images, "DP noise check", |_, rng| {
             let mut det = make();
             det.configure(cfg, 0).map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -249,7 +239,7 @@ where
         bail!("target check: no target track of {n} frames fits an {m} x {m} image");
     }
     // hits[image][frame][threshold set]
-    let hits: Vec<Result<Vec<Vec<usize>>>> = pool()?.install(|| {
+    let hits: Vec<Result<Vec<Vec<usize>>>> = crate::montecarlo::pool().install(|| {
         run_trials(seed, images, "DP target check", |_, rng| {
             let mut det = make();
             det.configure(cfg, 0).map_err(|e| anyhow::anyhow!("{e}"))?;
