@@ -39,6 +39,9 @@ enum Command {
     Detect(DetectArgs),
     /// Write a preset's frames in the format `faint detect` reads, with a truth file.
     Simulate(SimulateArgs),
+    /// Thresholds at a false-alarm probability for a detector, from noise-only data or
+    /// from a noise model estimated on a recording (for `faint detect --calibration`).
+    Calibrate(faint::host::calibrate::Args),
     /// Drive detectors with mutated configurations and hostile frames; write the findings.
     Fuzz(faint::host::reliability::cli::FuzzArgs),
     /// Stream plausible frames through detectors without reset; report cost drift and memory.
@@ -72,8 +75,12 @@ struct DetectArgs {
     gospa_c: Option<f64>,
     /// Write (and score) only detections with at least this score [default: 0.5 for an
     /// existence probability, everything otherwise].
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "calibration")]
     min_score: Option<f32>,
+    /// Write (and score) only detections above the per-frame thresholds of a calibration
+    /// file (`faint calibrate`), made for this detector and configuration.
+    #[arg(long)]
+    calibration: Option<PathBuf>,
     /// Also write every frame's full report (`reports.json`).
     #[arg(long)]
     reports: bool,
@@ -171,6 +178,30 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             );
             Ok(())
         }
+        Command::Calibrate(a) => {
+            let cal = faint::host::calibrate::run(&a)?;
+            let values: Vec<f32> = cal.thresholds.iter().filter_map(|t| t.value).collect();
+            let lo = values.iter().copied().fold(f32::INFINITY, f32::min);
+            let hi = values.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+            println!(
+                "{}: Pfa {} per frame from frame {} to {}: {} noise runs of {} frames; {} thresholds on the {} score{}; written to {}",
+                cal.detector,
+                cal.pfa,
+                cal.burn_in,
+                cal.run_frames - 1,
+                cal.runs,
+                cal.run_frames,
+                cal.thresholds.len(),
+                cal.score,
+                if values.is_empty() {
+                    " (every one minus infinity: the noise reported nothing)".to_string()
+                } else {
+                    format!(" in [{lo}, {hi}]")
+                },
+                a.out.display()
+            );
+            Ok(())
+        }
         Command::Fuzz(a) => faint::host::reliability::cli::fuzz_command(&a),
         Command::Soak(a) => faint::host::reliability::cli::soak_command(&a),
         Command::Reproduce(r) => match r {
@@ -219,13 +250,25 @@ fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/detect").join(entry.name));
+    let calibration = match &a.calibration {
+        Some(p) => Some(detect::calibration::Calibration::load(p)?),
+        None => None,
+    };
     let req = detect::Request {
         input,
         config: a.config.as_deref().zip(text.as_deref()),
         seed: a.seed,
         reports: a.reports,
+        restart_every: None,
     };
     let outcome = (entry.run)(&req)?;
+    if let Some(cal) = &calibration {
+        let config: serde_json::Value = match &text {
+            Some(t) => serde_json::from_str(t)?,
+            None => serde_json::from_str(&(entry.default_config)())?,
+        };
+        cal.check(entry.name, &config, outcome.frames)?;
+    }
     let truth = match &a.truth {
         Some(p) => {
             anyhow::ensure!(
@@ -246,21 +289,32 @@ fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
         ScoreKind::Existence => 0.5,
         _ => f32::NEG_INFINITY,
     });
+    let select = match &calibration {
+        Some(c) => detect::Selection::Calibrated(c),
+        None => detect::Selection::MinScore(min_score),
+    };
     let c = a.gospa_c.unwrap_or(if outcome.position.len() == 1 {
         2.0
     } else {
         100.0
     });
     let t = faint::host::timing::thread_cpu_seconds();
-    let w = detect::write(&outcome, &out_dir, min_score, truth.as_deref(), c)?;
+    let w = detect::write(&outcome, &out_dir, select, truth.as_deref(), c)?;
     let write_seconds = faint::host::timing::thread_cpu_seconds() - t;
     let t = faint::host::timing::thread_cpu_seconds();
     if !a.no_plots {
-        detect::write_plots(&outcome, &out_dir, min_score)?;
+        detect::write_plots(&outcome, &out_dir, select)?;
     }
     let plot_seconds = faint::host::timing::thread_cpu_seconds() - t;
+    let rule = match &calibration {
+        Some(c) => format!(
+            "above the thresholds at Pfa {} per frame from frame {}",
+            c.pfa, c.burn_in
+        ),
+        None => format!("score >= {min_score}"),
+    };
     println!(
-        "{}: {} frames, {} detections (score >= {min_score}) written to {}",
+        "{}: {} frames, {} detections ({rule}) written to {}",
         entry.name,
         outcome.frames,
         w.detections,

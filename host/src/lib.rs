@@ -11,6 +11,7 @@
 //! - [`scenario`]: one module per paper's scene (presets are data).
 //! - [`reproduce`]: one module per paper, behind `faint reproduce <name>`.
 //! - [`detect`]: every detector on a user's files, behind `faint detect <name>`.
+//! - [`calibrate`]: thresholds at a false-alarm probability, behind `faint calibrate <name>`.
 //! - [`timing`]: this thread's CPU time, for measurements on a shared machine.
 //! - [`cli`]: checks and parsers of command-line values shared by every command.
 //! - [`reliability`]: fuzz and soak campaigns over every detector (`faint fuzz`, `faint soak`).
@@ -19,6 +20,7 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod calibrate;
 pub mod cli;
 pub mod detect;
 pub mod io;

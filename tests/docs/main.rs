@@ -177,6 +177,11 @@ fn scratch(root: &Path, doc: &str) -> PathBuf {
     d
 }
 
+/// `cd DIR` alone: it moves the lines after it, so it always runs.
+fn is_bare_cd(cmd: &str) -> bool {
+    cmd.starts_with("cd ") && !cmd.contains("&&") && !cmd.contains(';')
+}
+
 /// A script's text for bash (release-binary paths through the shims, markers applied)
 /// and the number of its commands that CI runs here (0: all run by `.ci/run` itself).
 fn script(it: &Item, ci: &str, skipped: &mut Vec<String>) -> (String, usize) {
@@ -193,15 +198,8 @@ fn script(it: &Item, ci: &str, skipped: &mut Vec<String>) -> (String, usize) {
             continue;
         } else if let Some(smoke) = l.smoke() {
             smoke.to_string()
-        } else if run_by_ci(&l.command, ci) {
-            // `.ci/run` runs it (tests, lints, firmware); a `cd` in it still applies.
-            if let Some(dir) = l
-                .command
-                .strip_prefix("cd ")
-                .and_then(|r| r.split("&&").next())
-            {
-                s.push_str(&format!("cd {}\n", dir.trim()));
-            }
+        } else if !is_bare_cd(&l.command) && run_by_ci(&l.command, ci) {
+            // `.ci/run` runs it (tests, lints, firmware).
             continue;
         } else {
             l.command.clone()

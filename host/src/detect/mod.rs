@@ -45,9 +45,10 @@ use crate::scenario::mht::SeaClutter;
 use crate::scenario::phd::{HostFilter, SixTargets, Variant};
 use crate::timing::thread_cpu_seconds as cpu;
 
+pub mod calibration;
 mod output;
 
-pub use output::{check_input, read_truth, write, write_plots, Written};
+pub use output::{check_input, read_truth, write, write_plots, Selection, Written};
 
 /// Particle counts the particle-filter detectors are built for (the capacity is a
 /// compile-time constant of the core).
@@ -108,6 +109,10 @@ pub struct Request<'a> {
     pub seed: u64,
     /// Collect every frame's report (for `reports.json`).
     pub reports: bool,
+    /// Restart the detector every this many frames (`faint calibrate`'s runs): before
+    /// frame `r L` it is reset with the stream `derive_seed(seed, r)`. Frame indices in
+    /// the outcome stay those of the input.
+    pub restart_every: Option<usize>,
 }
 
 /// One detection of one frame.
@@ -598,25 +603,45 @@ where
     let mut reports = Vec::with_capacity(if keep_reports { n } else { 0 });
     let mut collect = 0.0f64;
     let t0 = cpu();
-    let res = run_frames(det, frames, |k, det, report| {
-        let t = std::time::Instant::now();
-        for d in det.detections() {
-            rows.push(Row {
-                frame: k,
-                score: d.score,
-                track_id: d.track.map(|t| t.id),
-                track_len: d.track.map(|t| t.len),
-                state: d.state().to_vec(),
-            });
+    let every = req.restart_every.unwrap_or(usize::MAX).max(1);
+    let frames: Vec<&D::Frame> = frames.collect();
+    let mut res = Ok(0);
+    for (r, chunk) in frames.chunks(every.min(n.max(1))).enumerate() {
+        if r > 0 {
+            det.reset(faint_core::rng::derive_seed(req.seed, r as u64));
         }
-        if keep_reports {
-            reports.push(report_json(report));
+        let first = r * every;
+        let part = run_frames(det, chunk.iter().copied(), |k, det, report| {
+            let k = first + k;
+            let t = std::time::Instant::now();
+            for d in det.detections() {
+                rows.push(Row {
+                    frame: k,
+                    score: d.score,
+                    track_id: d.track.map(|t| t.id),
+                    track_len: d.track.map(|t| t.len),
+                    state: d.state().to_vec(),
+                });
+            }
+            if keep_reports {
+                reports.push(report_json(report));
+            }
+            if k % 64 == 0 {
+                pb.set_position(k as u64);
+            }
+            collect += t.elapsed().as_secs_f64();
+        });
+        match part {
+            Ok(m) => res = res.map(|done| done + m),
+            Err(e) => {
+                res = Err(faint_core::detect::FrameError {
+                    frame: first + e.frame,
+                    error: e.error,
+                });
+                break;
+            }
         }
-        if k % 64 == 0 {
-            pb.set_position(k as u64);
-        }
-        collect += t.elapsed().as_secs_f64();
-    });
+    }
     let total = cpu() - t0;
     pb.finish_and_clear();
     let frames = res.map_err(|e| anyhow!("{}: frame {}: {}", input.display(), e.frame, e.error))?;

@@ -94,8 +94,35 @@ struct DetectionRecord<'a> {
 #[derive(Serialize)]
 struct FrameSummary {
     frame: usize,
+    /// Detections the detector reported (before any selection).
     detections: usize,
     best_score: Option<f32>,
+    /// Detections written (above the threshold or the minimum score).
+    declared: usize,
+    /// The calibrated threshold of the frame (empty without a calibration, before the
+    /// burn-in; `-inf` when every detection counts).
+    threshold: Option<f32>,
+    /// The calibration's false-alarm probability per frame (empty without one).
+    pfa: Option<f64>,
+}
+
+/// Which detections `faint detect` writes.
+#[derive(Debug, Clone, Copy)]
+pub enum Selection<'a> {
+    /// Those with a score of at least this.
+    MinScore(f32),
+    /// Those above the calibrated threshold of their frame.
+    Calibrated(&'a super::calibration::Calibration),
+}
+
+impl Selection<'_> {
+    /// True if `r` is written.
+    pub fn keeps(&self, r: &super::Row) -> bool {
+        match self {
+            Selection::MinScore(m) => r.score >= *m,
+            Selection::Calibrated(c) => c.declares(r.frame, r.score),
+        }
+    }
 }
 
 #[derive(Serialize)]
@@ -109,20 +136,20 @@ struct GospaRow {
     false_targets: f64,
 }
 
-/// Writes the outcome's data files to `dir`: the detections with a score of at least
-/// `min_score` (`detections.csv`, `detections.json`), every frame's count and best score
-/// (`summary.csv`, unfiltered), the reports if collected (`reports.json`) and, with a
+/// Writes the outcome's data files to `dir`: the detections `select` keeps
+/// (`detections.csv`, `detections.json`), every frame's reported count and best score, the
+/// written count and, with a calibration, the frame's threshold and Pfa (`summary.csv`), the reports if collected (`reports.json`) and, with a
 /// truth, the per-frame GOSPA (`gospa.csv`; cut-off `c`, order 2, alpha = 2) between the
 /// truth and the written detections' positions. The plots are [`write_plots`].
 pub fn write(
     out: &Outcome,
     dir: &Path,
-    min_score: f32,
+    select: Selection,
     truth: Option<&[Vec<Vec<f64>>]>,
     c: f64,
 ) -> Result<Written> {
     crate::cli::out_dir(dir)?;
-    let kept: Vec<&super::Row> = out.rows.iter().filter(|r| r.score >= min_score).collect();
+    let kept: Vec<&super::Row> = out.rows.iter().filter(|r| select.keeps(r)).collect();
     // detections.csv: fixed columns, then one per state component.
     let path = dir.join("detections.csv");
     let mut w = csv::Writer::from_path(&path)
@@ -169,12 +196,25 @@ pub fn write(
             frame,
             detections: 0,
             best_score: None,
+            declared: 0,
+            threshold: match select {
+                // Thresholds are f32 scores: the narrowing is exact.
+                Selection::Calibrated(c) => c.threshold(frame).value().map(|t| t as f32),
+                Selection::MinScore(_) => None,
+            },
+            pfa: match select {
+                Selection::Calibrated(c) => Some(c.pfa),
+                Selection::MinScore(_) => None,
+            },
         })
         .collect();
     for r in &out.rows {
         if let Some(s) = summary.get_mut(r.frame) {
             s.detections += 1;
             s.best_score = Some(s.best_score.map_or(r.score, |b| b.max(r.score)));
+            if select.keeps(r) {
+                s.declared += 1;
+            }
         }
     }
     write_csv(dir.join("summary.csv"), &summary)?;
@@ -239,11 +279,11 @@ pub fn write(
 }
 
 /// Draws the plots of a written outcome into `dir`: `score.svg` (best score per frame)
-/// and `tracks.svg` (the detections with a score of at least `min_score` over the input).
+/// and `tracks.svg` (the detections `select` keeps, over the input).
 /// Long inputs are drawn in blocks of frames (at most 400 columns) and with at most
 /// 20 000 background plots, so the files stay small.
-pub fn write_plots(out: &Outcome, dir: &Path, min_score: f32) -> Result<()> {
-    let kept: Vec<&super::Row> = out.rows.iter().filter(|r| r.score >= min_score).collect();
+pub fn write_plots(out: &Outcome, dir: &Path, select: Selection) -> Result<()> {
+    let kept: Vec<&super::Row> = out.rows.iter().filter(|r| select.keeps(r)).collect();
     let mut best = vec![None::<f32>; out.frames];
     for r in &out.rows {
         if let Some(b) = best.get_mut(r.frame) {
