@@ -147,9 +147,11 @@ fn looks_like_command(span: &str) -> bool {
     match first {
         Some(k) => {
             let rest = words[k..].join(" ");
-            // A bare folder (`target/ci/`) is a path, not a command.
-            let folder = rest.ends_with('/') && !rest.contains(' ');
-            !folder && (rest == ".ci/run" || STARTS.iter().any(|s| rest.starts_with(s)))
+            // A bare folder (`target/ci/`) or a data file (`target/ci/run.txt`) is a path,
+            // not a command.
+            let last = rest.rsplit('/').next().unwrap_or("");
+            let path = !rest.contains(' ') && (rest.ends_with('/') || last.contains('.'));
+            !path && (rest == ".ci/run" || STARTS.iter().any(|s| rest.starts_with(s)))
         }
         None => false,
     }
@@ -318,6 +320,10 @@ mod tests {
             ("echo \"a # b\"", Some(" c"))
         );
         assert!(is_synopsis("nice -n 10"));
+        assert!(!looks_like_command("target/ci/doc-commands.txt"));
+        assert!(!looks_like_command("target/ci/"));
+        assert!(looks_like_command("target/checked/faint soak crpf"));
+        assert!(looks_like_command("./target/release/faint"));
         assert!(is_synopsis("cargo run --release --"));
         assert!(!is_synopsis("FAINT_RUNS=1 cargo run --release --example x"));
     }
