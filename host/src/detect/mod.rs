@@ -603,10 +603,11 @@ where
     let mut reports = Vec::with_capacity(if keep_reports { n } else { 0 });
     let mut collect = 0.0f64;
     let t0 = cpu();
-    let every = req.restart_every.unwrap_or(usize::MAX).max(1);
+    // One chunk of the whole input unless the runs of `faint calibrate` restart it.
+    let every = req.restart_every.unwrap_or(n).max(1);
     let frames: Vec<&D::Frame> = frames.collect();
     let mut res = Ok(0);
-    for (r, chunk) in frames.chunks(every.min(n.max(1))).enumerate() {
+    for (r, chunk) in frames.chunks(every).enumerate() {
         if r > 0 {
             det.reset(faint_core::rng::derive_seed(req.seed, r as u64));
         }
