@@ -19,40 +19,36 @@
 
 use std::path::Path;
 
-use anyhow::{anyhow, bail, ensure, Result};
-use faint_core::detect::bernoulli::BernoulliTbd;
-use faint_core::detect::cbmember::CbmemberConfig;
-use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
-use faint_core::detect::dp::{DpConfig, DpReport, Method};
-use faint_core::detect::mht::{ClassicHoughConfig, MhtConfig};
-use faint_core::detect::pf_lrt::PfLrt;
-use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint_core::detect::phd::PhdConfig;
+use anyhow::{anyhow, Result};
+use faint_core::detect::dp::Method;
 use faint_core::detect::{run as run_frames, Detector, ScoreKind, Validate};
-use faint_core::model::doppler::estimate_noise_variance;
 use faint_core::model::plot::Plot;
 use faint_core::model::range_doppler::PointModel;
 use faint_core::Complex32;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-use crate::io::input::{read_complex_frames, read_plots, read_real_frames, Frames};
 use crate::montecarlo::progress_bar;
-use crate::reproduce::mht::{Classic, Mht};
-use crate::scenario::cbmember::HostFilter as CbmemberHost;
-use crate::scenario::dp::with_dp;
-use crate::scenario::mht::SeaClutter;
-use crate::scenario::phd::{HostFilter, SixTargets, Variant};
 use crate::timing::thread_cpu_seconds as cpu;
 
 pub mod calibration;
+mod cbmember;
+mod doppler;
+mod dp;
 mod output;
+mod phd;
+mod plots;
 
+pub use doppler::{GaussFile, PARTICLES};
+pub use dp::DpFile;
 pub use output::{check_input, read_truth, write, write_plots, Selection, Written};
+pub use plots::default_classic;
 
-/// Particle counts the particle-filter detectors are built for (the capacity is a
-/// compile-time constant of the core).
-pub const PARTICLES: [usize; 4] = [1000, 2000, 4000, 6000];
+use cbmember::{default_cbmember, run_cbmember};
+use doppler::{default_crpf, default_gauss, run_crpf, run_gauss};
+use dp::{default_dp, run_dp};
+use phd::{default_phd, run_phd};
+use plots::{default_hough, default_mht, run_classic, run_mht};
 
 /// What a detector reads, one frame at a time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -177,18 +173,16 @@ pub struct Outcome {
     pub collect_seconds: f64,
 }
 
+/// The state indices of an `(x, y)` position.
+const XY_POSITION: &[usize] = &[0, 1];
+
 /// Every detector `faint detect` can run.
 pub const REGISTRY: &[Entry] = &[
     Entry {
         name: "crpf",
         about: "CRPF-TBD, cost-reference particle filter with existence (Lu, Wang, Zhang 2017)",
         input: InputKind::DopplerFrames,
-        default_config: || {
-            json(&Particles {
-                particles: 1000,
-                config: CrpfConfig::othr(),
-            })
-        },
+        default_config: default_crpf,
         run: run_crpf,
     },
     Entry {
@@ -217,43 +211,35 @@ pub const REGISTRY: &[Entry] = &[
         name: "mht",
         about: "MHT-TBD, modified and data-matched Hough transform TBD (Bao et al. 2022)",
         input: InputKind::Plots,
-        default_config: || {
-            json(&Plain {
-                config: MhtConfig::sea_clutter(),
-            })
-        },
+        default_config: default_mht,
         run: run_mht,
     },
     Entry {
         name: "hough-classic",
         about: "classic two-stage Hough TBD, binary integration (Carlson, Evans, Wilson 1994)",
         input: InputKind::Plots,
-        default_config: || {
-            json(&Plain {
-                config: default_classic(),
-            })
-        },
+        default_config: default_hough,
         run: run_classic,
     },
     Entry {
         name: "phd-tbd",
         about: "SMC-PHD TBD with K-means extraction (the baseline of Pei et al. 2019)",
         input: InputKind::PowerCubes,
-        default_config: || default_phd(Variant::PhdTbd),
+        default_config: || default_phd(phd::Variant::PhdTbd),
         run: |r| run_phd(r, "phd-tbd"),
     },
     Entry {
         name: "pso-phd-kmeans",
         about: "PSO-PHD-TBD, NSGA-II particle swarm, K-means extraction (Pei et al. 2019)",
         input: InputKind::PowerCubes,
-        default_config: || default_phd(Variant::PsoKMeans),
+        default_config: || default_phd(phd::Variant::PsoKMeans),
         run: |r| run_phd(r, "pso-phd-kmeans"),
     },
     Entry {
         name: "pso-phd-dbscan",
         about: "PSO-PHD-TBD, NSGA-II particle swarm, DBSCAN extraction (Pei et al. 2019)",
         input: InputKind::PowerCubes,
-        default_config: || default_phd(Variant::PsoDbscan),
+        default_config: || default_phd(phd::Variant::PsoDbscan),
         run: |r| run_phd(r, "pso-phd-dbscan"),
     },
     Entry {
@@ -293,131 +279,6 @@ pub const REGISTRY: &[Entry] = &[
     },
 ];
 
-/// A DP-TBD detector's configuration file: `q_B` (9 or 25, compiled in) and the core
-/// configuration; `M = 128` and `L = 40` are compiled in.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct DpFile {
-    /// Predecessor window `q_B`: 9 (3 x 3, up to 1 px/frame) or 25 (5 x 5, up to 2).
-    pub q_b: usize,
-    /// The core configuration.
-    pub config: DpConfig,
-}
-
-fn default_dp(method: Method) -> String {
-    json(&DpFile {
-        q_b: 9,
-        config: DpConfig::dim_point(method, 1),
-    })
-}
-
-/// A DP report as one line of `reports.json`.
-#[derive(Serialize)]
-struct DpReportJson {
-    frame: u32,
-    best_x: u16,
-    best_y: u16,
-    best_merit: f32,
-    clamped: u32,
-}
-
-fn dp_report_json(r: &DpReport) -> String {
-    serde_json::to_string(&DpReportJson {
-        frame: r.frame,
-        best_x: r.best.x,
-        best_y: r.best.y,
-        best_merit: r.best.merit,
-        clamped: r.clamped,
-    })
-    .unwrap_or_default()
-}
-
-fn run_dp(req: &Request, name: &'static str, method: Method) -> Result<Outcome> {
-    let t = cpu();
-    let default = find_default(name);
-    let file: DpFile = load(req, default, |f: &DpFile| {
-        ensure!(
-            f.q_b == 9 || f.q_b == 25,
-            "q_b = {}: must be 9 or 25 (compiled in)",
-            f.q_b
-        );
-        ensure!(
-            f.config.method == method,
-            "config.method is {:?}; {name} runs {:?}",
-            f.config.method,
-            method
-        );
-        valid(&f.config)
-    })?;
-    let images = read_real_frames(req.input, 3)?;
-    let m = crate::scenario::dp::SIDE;
-    ensure!(
-        images.shape[1..] == [m, m],
-        "{}: images of shape {:?}, the DP detectors are built for (K, {m}, {m})",
-        req.input.display(),
-        images.shape
-    );
-    let read = cpu() - t;
-    let cfg = file.config;
-    let mut out = with_dp!(method, file.q_b, &cfg, |det| {
-        let mut det = det;
-        drive_with(
-            name,
-            det.as_mut(),
-            (0..images.frames()).map(|k| images.frame(k)),
-            req,
-            XY_POSITION,
-            dp_report_json,
-        )?
-    });
-    out.read_seconds = read;
-    Ok(out)
-}
-
-fn default_cbmember(model: PointModel) -> String {
-    json(&Plain {
-        config: CbmemberConfig {
-            model,
-            ..CbmemberConfig::rotor_uav()
-        },
-    })
-}
-
-fn run_cbmember(req: &Request, name: &'static str, model: PointModel) -> Result<Outcome> {
-    let t = cpu();
-    let default = match model {
-        PointModel::Joint => find_default("cbmember"),
-        PointModel::DopplerOnly => find_default("cbmember-doppler"),
-    };
-    let file: Plain<CbmemberConfig> =
-        load(req, default, |f: &Plain<CbmemberConfig>| valid(&f.config))?;
-    let maps = read_real_frames(req.input, 3)?;
-    let g = file.config.geometry;
-    let want = [g.n_range, g.n_velocity];
-    ensure!(
-        maps.shape[1..] == want,
-        "{}: maps of shape {:?}, the config's geometry is (n_range, n_velocity) = {:?}",
-        req.input.display(),
-        &maps.shape[1..],
-        want
-    );
-    let read = cpu() - t;
-    let cfg = file.config;
-    let mut det =
-        crate::montecarlo::on_worker_stack(move || CbmemberHost::new(cfg, 0).map(Box::new))
-            .map_err(|e| anyhow!("{e}"))?;
-    det.configure(&cfg, req.seed).map_err(|e| anyhow!("{e}"))?;
-    let mut out = drive(
-        name,
-        det.as_mut(),
-        (0..maps.frames()).map(|k| maps.frame(k)),
-        req,
-        &[0, 1],
-    )?;
-    out.read_seconds = read;
-    Ok(out)
-}
-
 /// The entry called `name`; an unknown name lists the known ones.
 pub fn find(name: &str) -> Result<&'static Entry> {
     REGISTRY.iter().find(|e| e.name == name).ok_or_else(|| {
@@ -439,19 +300,6 @@ pub struct Particles<C> {
     pub config: C,
 }
 
-/// A Gaussian comparator's configuration file.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GaussFile {
-    /// Particles (one of [`PARTICLES`]).
-    pub particles: usize,
-    /// Replace `config.noise_var` by the mean bin power of the whole input
-    /// (`estimate_noise_variance`), as the reproduction does with each run.
-    pub estimate_noise: bool,
-    /// The core configuration.
-    pub config: GaussConfig,
-}
-
 /// The configuration file of a detector without a particle count.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -463,40 +311,6 @@ pub struct Plain<C> {
 /// Pretty JSON of a configuration file (`f32` values print as their shortest form).
 fn json<T: Serialize>(v: &T) -> String {
     serde_json::to_string_pretty(v).unwrap_or_default()
-}
-
-fn default_gauss() -> String {
-    json(&GaussFile {
-        particles: 1000,
-        estimate_noise: true,
-        config: GaussConfig::othr(1.0),
-    })
-}
-
-/// The classic Hough TBD's default: the sea-clutter area and period, and the threshold
-/// the binomial strip model gives for a whole-grid false-alarm rate of 1e-4 at a clutter
-/// density of 80 plots per scan (28 counts; the reproduction's value at that density).
-pub fn default_classic() -> ClassicHoughConfig {
-    let sc = SeaClutter::paper(80.0);
-    let gamma = crate::analysis::mht::classic_gamma(
-        f64::from(sc.area[1] - sc.area[0]),
-        crate::reproduce::mht::NR,
-        crate::reproduce::mht::NT,
-        sc.n_scans,
-        f64::from(sc.lambda),
-        1e-4,
-    );
-    ClassicHoughConfig {
-        area: sc.area,
-        n_scans: sc.n_scans,
-        gamma: gamma.min(255) as u8,
-    }
-}
-
-fn default_phd(v: Variant) -> String {
-    json(&Plain {
-        config: SixTargets::new(9.0).config(v),
-    })
 }
 
 /// Parses the configuration file (or the defaults) into `T` and validates `config`.
@@ -520,47 +334,6 @@ fn load<T: DeserializeOwned>(
 
 fn valid<C: Validate>(c: &C) -> Result<()> {
     c.validate().map_err(|e| anyhow!("{e}"))
-}
-
-fn particles_ok(n: usize) -> Result<()> {
-    ensure!(
-        PARTICLES.contains(&n),
-        "particles = {n}: must be one of {PARTICLES:?}"
-    );
-    Ok(())
-}
-
-/// Reads Doppler frames and checks their bin count against the model's.
-fn doppler_input(req: &Request, bins: usize) -> Result<Frames<Complex32>> {
-    let f = read_complex_frames(req.input)?;
-    ensure!(
-        f.frame_len() == bins,
-        "{}: frames have {} bins, the config's model.bins is {bins}",
-        req.input.display(),
-        f.frame_len()
-    );
-    Ok(f)
-}
-
-/// The frames as the plots' background: bin `b` is the frequency `b / (m ts)`, aliased
-/// into the band `[-1/(2 ts), 1/(2 ts))`.
-fn doppler_view(f: Frames<Complex32>, ts: f32) -> InputView {
-    let bins = f.frame_len();
-    let width = 1.0 / ts;
-    let bin_hz = (0..bins)
-        .map(|b| {
-            let f = b as f32 * width / bins as f32;
-            if f >= 0.5 * width {
-                f - width
-            } else {
-                f
-            }
-        })
-        .collect();
-    InputView::Doppler {
-        frames: f.data,
-        bin_hz,
-    }
 }
 
 /// Drives `det` over `frames` with the core's frame loop, timing the detector apart from
@@ -661,219 +434,9 @@ where
     })
 }
 
-/// Builds a boxed detector of `N` particles and drives it.
-macro_rules! with_particles {
-    ($n:expr, $ty:ident, |$det:ident| $body:expr) => {
-        match $n {
-            1000 => {
-                let $det = Box::new($ty::<1000>::default_for_box()?);
-                $body
-            }
-            2000 => {
-                let $det = Box::new($ty::<2000>::default_for_box()?);
-                $body
-            }
-            4000 => {
-                let $det = Box::new($ty::<4000>::default_for_box()?);
-                $body
-            }
-            6000 => {
-                let $det = Box::new($ty::<6000>::default_for_box()?);
-                $body
-            }
-            n => bail!("particles = {n}: must be one of {PARTICLES:?}"),
-        }
-    };
-}
-
-/// A detector built with a valid preset, to be configured in place by the caller.
-trait DefaultForBox: Sized {
-    fn default_for_box() -> Result<Self>;
-}
-
-impl<const N: usize> DefaultForBox for CrpfTbd<N> {
-    fn default_for_box() -> Result<Self> {
-        CrpfTbd::new(CrpfConfig::othr(), 0).map_err(|e| anyhow!("{e}"))
-    }
-}
-
-macro_rules! gauss_default {
-    ($($t:ident),*) => {$(
-        impl<const N: usize> DefaultForBox for $t<N> {
-            fn default_for_box() -> Result<Self> {
-                $t::new(GaussConfig::othr(1.0), 0).map_err(|e| anyhow!("{e}"))
-            }
-        }
-    )*};
-}
-gauss_default!(PfTbd, BernoulliTbd, PfLrt);
-
-const DOPPLER_POSITION: &[usize] = &[0];
-const XY_POSITION: &[usize] = &[0, 1];
-const PHD_POSITION: &[usize] = &[0, 2];
-
-fn run_crpf(req: &Request) -> Result<Outcome> {
-    let t = cpu();
-    let file: Particles<CrpfConfig> = load(req, find_default("crpf"), |f: &Particles<_>| {
-        particles_ok(f.particles)?;
-        valid(&f.config)
-    })?;
-    let frames = doppler_input(req, file.config.model.bins)?;
-    let read = cpu() - t;
-    let mut out = with_particles!(file.particles, CrpfTbd, |det| {
-        let mut det = det;
-        det.configure(&file.config, req.seed)
-            .map_err(|e| anyhow!("{e}"))?;
-        drive(
-            "crpf",
-            det.as_mut(),
-            frame_slices(&frames),
-            req,
-            DOPPLER_POSITION,
-        )?
-    });
-    out.view = doppler_view(frames, file.config.model.ts);
-    out.read_seconds = read;
-    Ok(out)
-}
-
-fn run_gauss(req: &Request, name: &'static str) -> Result<Outcome> {
-    let t = cpu();
-    let file: GaussFile = load(req, default_gauss, |f: &GaussFile| {
-        particles_ok(f.particles)?;
-        if f.estimate_noise {
-            // The variance is replaced from the input; check the rest with a valid one.
-            valid(&GaussConfig {
-                noise_var: 1.0,
-                ..f.config
-            })
-        } else {
-            valid(&f.config)
-        }
-    })?;
-    let bins = file.config.model.bins;
-    let frames = doppler_input(req, bins)?;
-    let mut cfg = file.config;
-    if file.estimate_noise {
-        cfg.noise_var = estimate_noise_variance(frame_slices(&frames), bins)
-            .map_err(|e| anyhow!("{}: noise variance: {e}", req.input.display()))?;
-    }
-    let read = cpu() - t;
-    macro_rules! go {
-        ($ty:ident) => {
-            with_particles!(file.particles, $ty, |det| {
-                let mut det = det;
-                det.configure(&cfg, req.seed).map_err(|e| anyhow!("{e}"))?;
-                drive(
-                    name,
-                    det.as_mut(),
-                    frame_slices(&frames),
-                    req,
-                    DOPPLER_POSITION,
-                )?
-            })
-        };
-    }
-    let mut out = match name {
-        "pf-tbd" => go!(PfTbd),
-        "jott" => go!(BernoulliTbd),
-        _ => go!(PfLrt),
-    };
-    out.view = doppler_view(frames, cfg.model.ts);
-    out.read_seconds = read;
-    Ok(out)
-}
-
-fn frame_slices(f: &Frames<Complex32>) -> impl ExactSizeIterator<Item = &[Complex32]> {
-    (0..f.frames()).map(move |k| f.frame(k))
-}
-
 fn find_default(name: &str) -> fn() -> String {
     REGISTRY
         .iter()
         .find(|e| e.name == name)
         .map_or(String::new, |e| e.default_config)
-}
-
-fn run_mht(req: &Request) -> Result<Outcome> {
-    let t = cpu();
-    let file: Plain<MhtConfig> = load(req, find_default("mht"), |f: &Plain<MhtConfig>| {
-        valid(&f.config)?;
-        ensure!(
-            f.config.n_scans <= crate::reproduce::mht::NS,
-            "invalid configuration value: n_scans (at most {} here)",
-            crate::reproduce::mht::NS
-        );
-        Ok(())
-    })?;
-    let scans = read_plots(req.input)?;
-    let read = cpu() - t;
-    let mut det = Box::new(Mht::unconfigured());
-    det.configure(&file.config, req.seed)
-        .map_err(|e| anyhow!("{e}"))?;
-    let mut out = drive(
-        "mht",
-        det.as_mut(),
-        scans.iter().map(|s| s.as_slice()),
-        req,
-        XY_POSITION,
-    )?;
-    out.view = InputView::Plots(scans);
-    out.read_seconds = read;
-    Ok(out)
-}
-
-fn run_classic(req: &Request) -> Result<Outcome> {
-    let t = cpu();
-    let file: Plain<ClassicHoughConfig> = load(
-        req,
-        find_default("hough-classic"),
-        |f: &Plain<ClassicHoughConfig>| valid(&f.config),
-    )?;
-    let scans = read_plots(req.input)?;
-    let read = cpu() - t;
-    let mut det = Box::new(Classic::new(file.config).map_err(|e| anyhow!("{e}"))?);
-    det.configure(&file.config, req.seed)
-        .map_err(|e| anyhow!("{e}"))?;
-    let mut out = drive(
-        "hough-classic",
-        det.as_mut(),
-        scans.iter().map(|s| s.as_slice()),
-        req,
-        &[],
-    )?;
-    out.view = InputView::Plots(scans);
-    out.read_seconds = read;
-    Ok(out)
-}
-
-fn run_phd(req: &Request, name: &'static str) -> Result<Outcome> {
-    let t = cpu();
-    let default = find_default(name);
-    let file: Plain<PhdConfig> = load(req, default, |f: &Plain<PhdConfig>| valid(&f.config))?;
-    let cubes = read_real_frames(req.input, 4)?;
-    let g = file.config.geometry;
-    let want = [g.n_range, g.n_doppler, g.n_azimuth];
-    ensure!(
-        cubes.shape[1..] == want,
-        "{}: cubes of shape {:?}, the config's geometry is (n_range, n_doppler, n_azimuth) = {:?}",
-        req.input.display(),
-        &cubes.shape[1..],
-        want
-    );
-    let read = cpu() - t;
-    let cfg = file.config;
-    // Large filter: built on a worker stack, then boxed.
-    let mut det = crate::montecarlo::on_worker_stack(move || HostFilter::new(cfg, 0).map(Box::new))
-        .map_err(|e| anyhow!("{e}"))?;
-    det.configure(&cfg, req.seed).map_err(|e| anyhow!("{e}"))?;
-    let mut out = drive(
-        name,
-        det.as_mut(),
-        (0..cubes.frames()).map(|k| cubes.frame(k)),
-        req,
-        PHD_POSITION,
-    )?;
-    out.read_seconds = read;
-    Ok(out)
 }
