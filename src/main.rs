@@ -320,6 +320,12 @@ fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
         w.detections,
         w.dir.display()
     );
+    for n in &outcome.notes {
+        println!("{}: {n}", entry.name);
+    }
+    for w in &outcome.warnings {
+        eprintln!("warning: {w}");
+    }
     println!(
         "CPU time: read {:.4} s, detector {:.4} s, collecting {:.4} s, writing {:.4} s, plots {:.4} s",
         outcome.read_seconds,

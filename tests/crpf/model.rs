@@ -111,7 +111,7 @@ fn scenario_dft_agrees_with_model_on_noise_free_target() {
 fn bad_configs_and_frames_are_errors() {
     use faint::core::Error;
     assert!(DopplerModel::new(4, 0.02, Window::Hamming).is_err());
-    assert!(DopplerModel::new(65, 0.02, Window::Hamming).is_err());
+    assert!(DopplerModel::new(MAX_BINS + 1, 0.02, Window::Hamming).is_err());
     assert!(DopplerModel::new(32, 0.0, Window::Hamming).is_err());
     assert!(DopplerModel::new(32, f32::NAN, Window::Hamming).is_err());
     let z = vec![Complex32::new(0.0, 0.0); 31];

@@ -2,20 +2,28 @@
 //! budget the docs state: CRPF-TBD 41 B/particle (28 B particle state + 1 B existence
 //! flag + 4 B log weight + 4 B weight + 4 B ancestor), PF-TBD 28 B (16 + 12), JOTT and PF-LRT 24 B (12 + 12), plus a
 //! fixed part under 11 KB (the response table as 128 interpolation rows of 5 bins x 4
-//! f32, 10 KB, and the previous frame) besides the tables of the cached projection
-//! (1.7 KB per model, and CRPF-TBD's 20 KB cache).
+//! f32, 10 KB) besides the tables of the cached projection (3.5 KB per model at the
+//! 512-bin capacity, and CRPF-TBD's 20 KB cache and 4 KB previous frame).
 
 use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::CrpfTbd;
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::PfTbd;
+use faint::core::model::doppler::MAX_BINS;
 use std::mem::size_of;
 
 fn check(name: &str, n: usize, size: usize, per: usize) {
-    // Every model holds the 1.5 KB table of the quadratic ||h||^2 and the 128 B bin
-    // table; CRPF-TBD also the 20 KB projection cache (1024 x 20 B + the frame stamp).
-    let cache = 1536 + 128 + if name == "CRPF-TBD" { 1024 * 20 + 4 } else { 0 };
-    let fixed = size as isize - (per * n) as isize - cache;
+    // Every model holds the 1.5 KB table of the quadratic ||h||^2 and the 2 KB bin
+    // table (u16 per position, 2 MAX_BINS); CRPF-TBD also the 20 KB projection cache
+    // (1024 x 20 B + the frame stamp) and its previous frame (MAX_BINS complex bins).
+    let cache = 1536
+        + 2 * 2 * MAX_BINS
+        + if name == "CRPF-TBD" {
+            1024 * 20 + 4 + 8 * MAX_BINS
+        } else {
+            0
+        };
+    let fixed = size as isize - (per * n) as isize - cache as isize;
     println!("{name:9} N = {n:5}: {size:7} B ({per} B/particle + {fixed} B)");
     assert!(
         (0..11 * 1024).contains(&fixed),

@@ -4,7 +4,7 @@
 use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::pf_tbd::GaussConfig;
 use faint::core::detect::Detector;
-use faint::core::model::doppler::{unwindow, ModelConfig, Window};
+use faint::core::model::doppler::{unwindow, ModelConfig, Window, MAX_BINS};
 use faint::core::rng::Rng;
 use faint::core::Complex32;
 use faint::host::scenario::crpf::{window_of, windowed_dft, Noise, Othr};
@@ -82,7 +82,11 @@ fn unwindow_rejects_bad_input() {
     assert!(unwindow(&mut z, Window::Hamming).is_err());
     assert!(z[3].re.is_nan() && z[4] == before[4]);
     assert!(unwindow(&mut [], Window::Hamming).is_err());
-    assert!(unwindow(&mut vec![Complex32::new(0.0, 0.0); 65], Window::Hamming).is_err());
+    assert!(unwindow(
+        &mut vec![Complex32::new(0.0, 0.0); MAX_BINS + 1],
+        Window::Hamming
+    )
+    .is_err());
     let mut r = before.clone();
     unwindow(&mut r, Window::Rectangular).unwrap();
     for (a, b) in r.iter().zip(&before) {

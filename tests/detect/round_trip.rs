@@ -62,7 +62,18 @@ fn rows_of<D: Detector>(
 
 /// Runs `faint detect <name>` on `input` with every detection written.
 fn detect(name: &str, input: &Path, out: &Path) -> Vec<(usize, u32, Vec<u32>)> {
-    let (code, _, err) = faint(&[
+    detect_with(name, input, out, None)
+}
+
+/// [`detect`] with a configuration file.
+fn detect_with(
+    name: &str,
+    input: &Path,
+    out: &Path,
+    config: Option<&Path>,
+) -> Vec<(usize, u32, Vec<u32>)> {
+    let seed = DET_SEED.to_string();
+    let mut args = vec![
         "detect",
         name,
         "--input",
@@ -70,13 +81,32 @@ fn detect(name: &str, input: &Path, out: &Path) -> Vec<(usize, u32, Vec<u32>)> {
         "--out",
         s(out),
         "--seed",
-        &DET_SEED.to_string(),
+        &seed,
         "--min-score",
         "-1e30",
         "--no-plots",
-    ]);
+    ];
+    if let Some(c) = config {
+        args.extend(["--config", s(c)]);
+    }
+    let (code, _, err) = faint(&args);
     assert_eq!(code, 0, "{name}: {err}");
     read_rows(&out.join("detections.csv"))
+}
+
+/// A Doppler detector's configuration file in the input's own units (`"noise":
+/// "as-is"`, the preset's prior box): the reproduction's settings.
+fn as_is(dir: &Path, name: &str, config: serde_json::Value) -> std::path::PathBuf {
+    let p = dir.join(format!("{name}-as-is.json"));
+    let v = serde_json::json!({
+        "particles": 1000,
+        "noise": "as-is",
+        "amplitude_snr_db": null,
+        "births_over_band": false,
+        "config": config,
+    });
+    std::fs::write(&p, v.to_string()).unwrap();
+    p
 }
 
 fn doppler_rows(reports: &[DopplerReport], lrt: bool) -> Vec<(usize, u32, Vec<u32>)> {
@@ -127,7 +157,16 @@ fn doppler_detectors_round_trip() {
         false,
     );
     assert!(want_crpf.len() > 20, "an estimate in most frames");
-    assert_eq!(detect("crpf", &file, &dir.join("crpf")), want_crpf);
+    // The reproduction works in the preset's absolute units and estimates the Gaussian
+    // comparators' variance as the mean bin power: the same settings as a file.
+    let crpf_cfg = as_is(
+        &dir,
+        "crpf",
+        serde_json::to_value(CrpfConfig::othr()).unwrap(),
+    );
+    let gauss_cfg = as_is(&dir, "gauss", serde_json::to_value(g).unwrap());
+    let run = |name: &str, cfg: &Path| detect_with(name, &file, &dir.join(name), Some(cfg));
+    assert_eq!(run("crpf", &crpf_cfg), want_crpf);
     let want = doppler_rows(
         &run_detector(
             &mut *Box::new(PfTbd::<1000>::new(g, DET_SEED).unwrap()),
@@ -136,7 +175,7 @@ fn doppler_detectors_round_trip() {
         .unwrap(),
         false,
     );
-    assert_eq!(detect("pf-tbd", &file, &dir.join("pf")), want);
+    assert_eq!(run("pf-tbd", &gauss_cfg), want);
     let want = doppler_rows(
         &run_detector(
             &mut *Box::new(BernoulliTbd::<1000>::new(g, DET_SEED).unwrap()),
@@ -145,7 +184,7 @@ fn doppler_detectors_round_trip() {
         .unwrap(),
         false,
     );
-    assert_eq!(detect("jott", &file, &dir.join("jott")), want);
+    assert_eq!(run("jott", &gauss_cfg), want);
     let want = doppler_rows(
         &run_detector(
             &mut *Box::new(PfLrt::<1000>::new(g, DET_SEED).unwrap()),
@@ -154,10 +193,104 @@ fn doppler_detectors_round_trip() {
         .unwrap(),
         true,
     );
-    assert_eq!(detect("pf-lrt", &file, &dir.join("lrt")), want);
+    assert_eq!(run("pf-lrt", &gauss_cfg), want);
     // The truth file beside it: the target's Doppler in frames 7..=26 (1-based).
     let truth = std::fs::read_to_string(dir.join("othr.truth.csv")).unwrap();
     assert_eq!(truth.lines().count(), 1 + 20);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The Doppler detectors' defaults are scale-free: the frames are divided by their
+/// estimated noise level. A power-of-two scale is exact in `f32` (and so are the median
+/// and the square root of a power-of-four ratio), so the detections keep their bits;
+/// before, the CRPF amplitude prior `[0.05, 1.5]` was absolute and frames x 10 were
+/// never detected.
+#[test]
+fn doppler_detectors_are_scale_free() {
+    use faint::host::io::input::read_complex_frames;
+    use faint::host::io::output::write_complex_frames;
+    let dir = temp("rt-scale");
+    let file = dir.join("othr.npy");
+    let (code, _, err) = faint(&[
+        "simulate",
+        "othr",
+        "--out",
+        s(&file),
+        "--seed",
+        "11",
+        "--snr-db",
+        "10",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let f = read_complex_frames(&file).unwrap();
+    let scaled = |k: f32, name: &str| {
+        let frames: Vec<Vec<faint::core::Complex32>> = (0..f.frames())
+            .map(|i| f.frame(i).iter().map(|z| z * k).collect())
+            .collect();
+        let p = dir.join(name);
+        write_complex_frames(&p, &frames).unwrap();
+        p
+    };
+    for name in ["crpf", "jott", "pf-lrt"] {
+        let base = detect(name, &file, &dir.join(format!("{name}-1")));
+        // The target (frames 7..=26, 1-based) is found: estimates in most frames.
+        assert!(base.len() > 20, "{name}: {} rows", base.len());
+        for (k, tag) in [(1024.0f32, "up"), (1.0 / 1024.0, "down")] {
+            let p = scaled(k, &format!("{name}-{tag}.npy"));
+            let rows = detect(name, &p, &dir.join(format!("{name}-{tag}")));
+            assert_eq!(rows, base, "{name} x {k}");
+        }
+    }
+    // x 10 and x 1e-3 are not exact in f32, and a particle filter's run diverges after
+    // the first rounding: compare over 8 detector seeds. The target (0-based frames
+    // 6..=25) counts as found when at least 3 of its frames have an existence above
+    // 0.5. Unscaled, 8 of 8 seeds find it at 10 dB (6 to 12 frames); each scaled copy
+    // must find it in at least 6 of 8, while the preset's absolute prior (as-is) finds
+    // it in at most 1 of 8 at x 10 (it used to be never).
+    let found = |input: &Path, cfg: Option<&Path>, seed: u64| -> bool {
+        let out = dir.join(format!("seed-{seed}"));
+        let seed = seed.to_string();
+        let mut args = vec![
+            "detect",
+            "crpf",
+            "--input",
+            s(input),
+            "--out",
+            s(&out),
+            "--seed",
+            &seed,
+            "--min-score",
+            "0.5",
+            "--no-plots",
+        ];
+        if let Some(c) = cfg {
+            args.extend(["--config", s(c)]);
+        }
+        let (code, _, err) = faint(&args);
+        assert_eq!(code, 0, "{err}");
+        let rows = read_rows(&out.join("detections.csv"));
+        rows.iter().filter(|r| (6..=25).contains(&r.0)).count() >= 3
+    };
+    let x10 = scaled(10.0, "x10.npy");
+    let milli = scaled(1e-3, "milli.npy");
+    let asis = as_is(
+        &dir,
+        "crpf",
+        serde_json::to_value(CrpfConfig::othr()).unwrap(),
+    );
+    for (input, cfg, lo, hi) in [
+        (&file, None, 8, 8),
+        (&x10, None, 6, 8),
+        (&milli, None, 6, 8),
+        (&x10, Some(asis.as_path()), 0, 1),
+    ] {
+        let n = (1..=8).filter(|&seed| found(input, cfg, seed)).count();
+        assert!(
+            (lo..=hi).contains(&n),
+            "{} {cfg:?}: found in {n} of 8 runs",
+            input.display()
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -181,10 +314,29 @@ fn hough_detectors_round_trip() {
     let mut mht = Box::new(Mht::new(MhtConfig::sea_clutter()).unwrap());
     let want = rows_of(mht.as_mut(), scans.iter().map(|s| s.as_slice()));
     assert!(!want.is_empty(), "MHT-TBD confirms tracks at lambda 80");
-    assert_eq!(detect("mht", &file, &dir.join("mht")), want);
+    // The configuration's thresholds as they are (`gamma_grid_pfa: null`), as the
+    // reproduction runs them.
+    let fixed = |name: &str, config: serde_json::Value| {
+        let p = dir.join(format!("{name}.json"));
+        let v = serde_json::json!({ "gamma_grid_pfa": null, "config": config });
+        std::fs::write(&p, v.to_string()).unwrap();
+        p
+    };
+    let cfg = fixed(
+        "mht",
+        serde_json::to_value(MhtConfig::sea_clutter()).unwrap(),
+    );
+    assert_eq!(
+        detect_with("mht", &file, &dir.join("mht"), Some(&cfg)),
+        want
+    );
     let mut classic = Box::new(Classic::new(default_classic()).unwrap());
     let want = rows_of(classic.as_mut(), scans.iter().map(|s| s.as_slice()));
-    assert_eq!(detect("hough-classic", &file, &dir.join("classic")), want);
+    let cfg = fixed("classic", serde_json::to_value(default_classic()).unwrap());
+    assert_eq!(
+        detect_with("hough-classic", &file, &dir.join("classic"), Some(&cfg)),
+        want
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

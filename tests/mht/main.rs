@@ -11,3 +11,4 @@ mod detector;
 mod model;
 mod paper_gamma;
 mod stages;
+mod thresholds;

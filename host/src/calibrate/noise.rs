@@ -16,9 +16,7 @@ use crate::detect::calibration::NoiseModel;
 use crate::detect::InputKind;
 use crate::io::input::{read_complex_frames, read_plots, read_real_frames};
 use crate::io::output::{write_complex_frames, write_plots, write_real_frames};
-
-/// `1.4826 MAD` estimates a Gaussian's standard deviation (`1 / Phi^-1(3/4)`).
-const MAD_TO_STD: f64 = 1.482_602_218_505_602;
+use crate::stats::noise::{median, MAD_TO_STD};
 
 /// What a file holds: its frame count and the shape of one frame (`[m]` Doppler bins,
 /// `[R, D, A]`, `[Nr, Nv]`, `[M, M]`; empty for plot lists).
@@ -58,20 +56,6 @@ pub fn layout(kind: InputKind, path: &Path) -> Result<Layout> {
                 frame_shape: f.shape[1..].to_vec(),
             }
         }
-    })
-}
-
-/// The median of `v` (sorted in place); `None` when empty.
-fn median(v: &mut [f64]) -> Option<f64> {
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    Some(if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
     })
 }
 
@@ -275,13 +259,6 @@ pub fn simulate(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn median_of_odd_and_even() {
-        assert_eq!(median(&mut [3.0, 1.0, 2.0]), Some(2.0));
-        assert_eq!(median(&mut [4.0, 1.0, 2.0, 3.0]), Some(2.5));
-        assert_eq!(median(&mut []), None);
-    }
 
     #[test]
     fn windowed_noise_has_the_estimated_bin_variance() {

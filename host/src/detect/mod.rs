@@ -7,9 +7,9 @@
 //! detector registers by adding one entry.
 //!
 //! The configuration file is JSON: `{"config": {...}}` holding the core configuration
-//! (e.g. `CrpfConfig`), plus `"particles"` for the particle filters (one of
-//! [`PARTICLES`]), `"estimate_noise"` for the Gaussian comparators and `"q_b"` for
-//! DP-TBD ([`DpFile`]). Unknown keys are rejected; values are checked by the core's own
+//! (e.g. `CrpfConfig`), plus `"particles"` (one of [`PARTICLES`]) and the noise level,
+//! SNR prior and birth settings for the Doppler-frame detectors ([`DopplerFile`]) and
+//! `"q_b"` for DP-TBD ([`DpFile`]). Unknown keys are rejected; values are checked by the core's own
 //! `validate`.
 //!
 //! Outputs ([`write()`]): `detections.csv` / `detections.json` (frame, detector, score,
@@ -39,10 +39,12 @@ mod output;
 mod phd;
 mod plots;
 
-pub use doppler::{GaussFile, PARTICLES};
+pub use doppler::{bin_variance, DopplerFile, GaussFile, NoiseLevel, PARTICLES};
 pub use dp::DpFile;
 pub use output::{check_input, read_truth, write, write_plots, Selection, Written};
-pub use plots::default_classic;
+pub use plots::{
+    classic_threshold, clutter_density, default_classic, mht_gamma, PlotFile, DEFAULT_GRID_PFA,
+};
 
 use cbmember::{default_cbmember, run_cbmember};
 use doppler::{default_crpf, default_gauss, run_crpf, run_gauss};
@@ -163,6 +165,12 @@ pub struct Outcome {
     /// Indices into the state of the position compared with a truth file (empty: the
     /// detector reports no positions).
     pub position: &'static [usize],
+    /// What the run set from the input (noise level, clutter density, thresholds), one
+    /// line each, for the user.
+    pub notes: Vec<String>,
+    /// What the user must know about the run's result (e.g. a threshold that cannot
+    /// hold the wanted false-alarm rate), one line each.
+    pub warnings: Vec<String>,
     /// CPU seconds spent reading and checking the input (and the configuration).
     pub read_seconds: f64,
     /// CPU seconds spent in the detector's `step` calls (the frame loop's CPU time less
@@ -288,16 +296,6 @@ pub fn find(name: &str) -> Result<&'static Entry> {
             known.join(", ")
         )
     })
-}
-
-/// A particle filter's configuration file: the particle count and the core config.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Particles<C> {
-    /// Particles (one of [`PARTICLES`]).
-    pub particles: usize,
-    /// The core configuration.
-    pub config: C,
 }
 
 /// The configuration file of a detector without a particle count.
@@ -428,6 +426,8 @@ where
         reports,
         view: InputView::None,
         position,
+        notes: Vec::new(),
+        warnings: Vec::new(),
         read_seconds: 0.0,
         detector_seconds: total - collect,
         collect_seconds: collect,

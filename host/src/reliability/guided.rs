@@ -512,7 +512,7 @@ pub const PARTICLES: usize = 64;
 /// Bins per frame of the Doppler-frame detectors' bases (the preset has 32): the
 /// response table `configure` builds costs `641 m` double-precision `sincos`, most of an
 /// input's time at 32 bins; the loops over bins are the same at 8 (an edit of `bins`
-/// still reaches 5..=64 and beyond).
+/// still reaches 5..=512 and beyond).
 pub const DOPPLER_BINS: usize = 8;
 
 /// Plot capacity of the classic Hough transform (its host value).

@@ -1,6 +1,8 @@
 //! Statistics of Monte Carlo runs: detection thresholds, rates and curves
-//! ([`detection`]), and the OSPA and GOSPA multi-target distances ([`ospa`], [`gospa`]).
+//! ([`detection`]), the OSPA and GOSPA multi-target distances ([`ospa`], [`gospa`]), and
+//! robust noise-level estimates of a recording ([`noise`]).
 
 pub mod detection;
 pub mod gospa;
+pub mod noise;
 pub mod ospa;

@@ -6,7 +6,7 @@ use crate::math;
 use crate::{Complex32, Error, Result};
 
 /// Largest frame length (bins) the fixed-size buffers hold.
-pub const MAX_BINS: usize = 64;
+pub const MAX_BINS: usize = 512;
 /// Half-width `J` of the evaluated bin span.
 pub const HALF_SPAN: usize = 2;
 /// Bins evaluated per particle: `2J + 1`.
@@ -105,7 +105,7 @@ pub struct DopplerModel {
     pub(super) u_scale: f32,
     pub(super) u_off: f32,
     /// `first_of[q] = (q - m - J) mod m` for `q = U >> 7 < 2m`.
-    pub(super) first_of: [u8; 2 * MAX_BINS],
+    pub(super) first_of: [u16; 2 * MAX_BINS],
     /// `[H0, H1, H2]` of each row: `sum_j |a_j + f d_j|^2 = H0 + f (H1 + f H2)`.
     pub(super) hq: [[f32; 3]; TABLE_STEPS],
     pub(super) window_sum: f32,
@@ -139,9 +139,9 @@ impl DopplerModel {
                 *cell = [a.re, a.im, b.re - a.re, b.im - a.im];
             }
         }
-        let mut first_of = [0u8; 2 * MAX_BINS];
+        let mut first_of = [0u16; 2 * MAX_BINS];
         for (q, f) in first_of.iter_mut().enumerate() {
-            *f = (q as i64 - m as i64 - HALF_SPAN as i64).rem_euclid(m as i64) as u8;
+            *f = (q as i64 - m as i64 - HALF_SPAN as i64).rem_euclid(m as i64) as u16;
         }
         let mut hq = [[0.0f32; 3]; TABLE_STEPS];
         for (h, row) in hq.iter_mut().zip(rows.iter()) {
@@ -189,7 +189,7 @@ impl DopplerModel {
     /// The errors of [`DopplerModel::new`] for `m` bins and sample interval `ts`.
     fn check(m: usize, ts: f32) -> Result<()> {
         if !(SPAN..=MAX_BINS).contains(&m) {
-            return Err(Error::InvalidConfig("bins per frame (5..=64)"));
+            return Err(Error::InvalidConfig("bins per frame (5..=512)"));
         }
         if !(ts.is_finite() && ts > 0.0) {
             return Err(Error::InvalidConfig("sample interval ts"));

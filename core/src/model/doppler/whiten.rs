@@ -28,7 +28,7 @@ use crate::{Complex32, Error, Result};
 pub fn unwindow(z: &mut [Complex32], window: Window) -> Result<()> {
     let m = z.len();
     if !(1..=MAX_BINS).contains(&m) {
-        return Err(Error::InvalidConfig("bins per frame (1..=64)"));
+        return Err(Error::InvalidConfig("bins per frame (1..=512)"));
     }
     check_frame(z, m)?;
     let mut inv_w = [0.0f64; MAX_BINS];

@@ -102,7 +102,8 @@ pub fn track_targets(track: &Track<NS>, trial: &Trial, t_scan: f32) -> Vec<usize
         .collect()
 }
 
-pub(super) fn max_count<const R: usize, const A: usize>(
+/// The largest binary-integration count of the accumulator's cells.
+pub fn max_count<const R: usize, const A: usize>(
     acc: &faint_core::detect::mht::Accumulator<R, A>,
 ) -> u8 {
     let mut m = 0;

@@ -37,8 +37,8 @@ pub use calibration::{
     thresholds_with, FalseTrackCounts, GridModel, PILOT_PERIODS,
 };
 pub use evaluation::{
-    detectors, evaluate_trial, target_plots_in, track_targets, Classic, Grid, Mht, TrialStats,
-    MATCH_TOL, NR, NS, NT, P, TR,
+    detectors, evaluate_trial, max_count, target_plots_in, track_targets, Classic, Grid, Mht,
+    TrialStats, MATCH_TOL, NR, NS, NT, P, TR,
 };
 pub use stages::{attribute, stage3_fates, Fate, Loss, StageReport};
 
