@@ -69,8 +69,12 @@ struct DetectArgs {
     /// detections against with GOSPA.
     #[arg(long)]
     truth: Option<PathBuf>,
+    /// Number of the first frame in the truth file: 0 (as `faint simulate` writes) or 1
+    /// (a file numbered from 1); the truth's frame `f` is the input's frame `f - N`.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=1))]
+    truth_first_frame: u64,
     /// GOSPA cut-off `c` in the position's units, finite and > 0 [default: 2 Hz Doppler,
-    /// 100 m x/y].
+    /// 100 m x/y, 3 px for pixels].
     #[arg(long, allow_hyphen_values = true)]
     gospa_c: Option<f64>,
     /// Write (and score) only detections with at least this score [default: 0.5 for an
@@ -281,7 +285,12 @@ fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
                 .iter()
                 .map(|&i| outcome.state_names.get(i).copied().unwrap_or("?"))
                 .collect();
-            Some(detect::read_truth(p, &names, outcome.frames)?)
+            Some(detect::read_truth(
+                p,
+                &names,
+                outcome.frames,
+                a.truth_first_frame as usize,
+            )?)
         }
         None => None,
     };
@@ -293,8 +302,15 @@ fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
         Some(c) => detect::Selection::Calibrated(c),
         None => detect::Selection::MinScore(min_score),
     };
+    let pixels = outcome
+        .position
+        .first()
+        .and_then(|&i| outcome.state_names.get(i))
+        .is_some_and(|n| n.ends_with("_px"));
     let c = a.gospa_c.unwrap_or(if outcome.position.len() == 1 {
         2.0
+    } else if pixels {
+        3.0
     } else {
         100.0
     });

@@ -458,6 +458,64 @@ fn truth_gives_gospa_and_plots() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A truth file numbered from 1 gives the same GOSPA with `--truth-first-frame 1`; read
+/// as 0-based, its last frame is past the input and the error says how to read it.
+#[test]
+fn truth_numbered_from_one() {
+    let dir = temp("rt-truth1");
+    let file = dir.join("othr.npy");
+    assert_eq!(faint(&["simulate", "othr", "--out", s(&file)]).0, 0);
+    let truth0 = std::fs::read_to_string(dir.join("othr.truth.csv")).unwrap();
+    // The preset's target lives to the last frame (0-based 31 of 32)? Shift every row.
+    let mut lines = truth0.lines();
+    let mut truth1 = format!("{}\n", lines.next().unwrap());
+    for l in lines {
+        let (f, rest) = l.split_once(',').unwrap();
+        truth1.push_str(&format!("{},{rest}\n", f.parse::<usize>().unwrap() + 1));
+    }
+    let t1 = dir.join("one.csv");
+    std::fs::write(&t1, &truth1).unwrap();
+    let run = |truth: &Path, extra: &[&str], out: &str| {
+        let mut args = vec![
+            "detect",
+            "crpf",
+            "--input",
+            s(&file),
+            "--truth",
+            s(truth),
+            "--out",
+        ];
+        let o = dir.join(out);
+        args.push(s(&o));
+        args.push("--no-plots");
+        args.extend_from_slice(extra);
+        let (code, _, err) = faint(&args);
+        (code, err, std::fs::read_to_string(o.join("gospa.csv")).ok())
+    };
+    let (code, err, g0) = run(&dir.join("othr.truth.csv"), &[], "a");
+    assert_eq!(code, 0, "{err}");
+    let (code, err, g1) = run(&t1, &["--truth-first-frame", "1"], "b");
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(g0, g1);
+    // The preset's target is present in frames 7..=26 (1-based): shifted by one more
+    // frame than the file holds, a row lands at frame 32 of 32 only if the truth
+    // reaches the last frame; shift the numbering by 6 to put one there.
+    let mut late = format!("{}\n", truth0.lines().next().unwrap());
+    for l in truth0.lines().skip(1) {
+        let (f, rest) = l.split_once(',').unwrap();
+        late.push_str(&format!("{},{rest}\n", f.parse::<usize>().unwrap() + 7));
+    }
+    let tl = dir.join("late.csv");
+    std::fs::write(&tl, &late).unwrap();
+    let (code, err, _) = run(&tl, &[], "c");
+    assert_eq!(code, 2);
+    assert!(err.contains("add --truth-first-frame 1"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    let (code, err, _) = run(&t1, &["--truth-first-frame", "2"], "d");
+    assert_eq!(code, 2, "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn cbmember_detectors_round_trip() {
     use faint::core::detect::cbmember::CbmemberConfig;

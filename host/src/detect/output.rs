@@ -11,10 +11,17 @@ use crate::io::plot::{heatmap, line_chart, scatter, Cell, Series};
 use crate::io::{write_csv, write_json, write_text};
 use crate::stats::gospa::{gospa_with, Gospa};
 
-/// Reads a truth file: CSV with the header `frame,<names...>` (0-based frame, one row per
-/// true object per frame, `names` the detector's position components, e.g. `x_m,y_m`).
-/// Returns the objects of each of `frames` frames.
-pub fn read_truth(path: &Path, names: &[&str], frames: usize) -> Result<Vec<Vec<Vec<f64>>>> {
+/// Reads a truth file: CSV with the header `frame,<names...>` (frames numbered from
+/// `first`, 0 or 1; one row per true object per frame, `names` the detector's position
+/// components, e.g. `x_m,y_m`). Returns the objects of each of `frames` frames. A row
+/// at frame `frames` read as 0-based (the last frame of a file numbered from 1) is an
+/// error that says so.
+pub fn read_truth(
+    path: &Path,
+    names: &[&str],
+    frames: usize,
+    first: usize,
+) -> Result<Vec<Vec<Vec<f64>>>> {
     let p = path.display();
     let mut r = csv::ReaderBuilder::new()
         .has_headers(true)
@@ -46,10 +53,24 @@ pub fn read_truth(path: &Path, names: &[&str], frames: usize) -> Result<Vec<Vec<
             )
         })?;
         ensure!(
-            frame < frames,
-            "truth {p}: row {}: frame {frame} is past the input's {frames} frames",
+            frame >= first,
+            "truth {p}: row {}: frame {frame} is before the first frame {first} \
+             (--truth-first-frame)",
             i + 1
         );
+        let k = frame - first;
+        if k >= frames {
+            let hint = if first == 0 && frame == frames {
+                " (the file looks numbered from 1: add --truth-first-frame 1)"
+            } else {
+                ""
+            };
+            bail!(
+                "truth {p}: row {}: frame {frame} is past the input's {frames} frames{hint}",
+                i + 1
+            );
+        }
+        let frame = k;
         let mut x = Vec::with_capacity(names.len());
         for (j, name) in names.iter().enumerate() {
             let v: f64 = rec
