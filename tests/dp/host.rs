@@ -224,3 +224,44 @@ fn bad_dp_inputs_are_one_clear_line() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A dim-point run (SNR 6, 1 px/frame, so its target wins every frame by far) written as
+/// `(40, 128, 128)` with `background` added to every pixel; returns the truth's pixel at
+/// each frame.
+fn bright_file(path: &Path, background: f32) -> Vec<(usize, usize)> {
+    let sc = DimPoint::default();
+    let run = sc
+        .run(
+            Some(6.0),
+            1,
+            &mut Rng::from_stream(DimPoint::target_seed(7, 1), 0),
+        )
+        .unwrap();
+    let data: Vec<f32> = run.frames.concat().iter().map(|z| z + background).collect();
+    write_real_frames(path, &[40, 128, 128], &data).unwrap();
+    let t = run.truth.unwrap();
+    (0..40).map(|k| t.pixel(k)).collect()
+}
+
+/// Regression (the case): a camera-like background of 3000 lay beyond the
+/// quantiser's +-1024 and was clamped silently, so every merit was equal and every
+/// detection was pixel (0, 0) with exit status 0. Now it is one line naming the frame and
+/// the cell.
+#[test]
+fn a_background_beyond_the_quantiser_is_refused_naming_the_cell() {
+    let dir = temp("bright");
+    let file = dir.join("bright.npy");
+    bright_file(&file, 3000.0);
+    let out = dir.join("out");
+    for name in ["dp-arnold", "dp-pulford", "dp-second"] {
+        let (code, stdout, err) = faint(&["detect", name, "--input", s(&file), "--out", s(&out)]);
+        assert_eq!(code, 2, "{name}: {stdout}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(
+            err.contains("bright.npy: frame 0, pixel (x, y) = (0, 0)") && err.contains("+-1024"),
+            "{err}"
+        );
+        assert!(!out.exists());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

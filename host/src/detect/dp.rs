@@ -1,7 +1,7 @@
 //! DP-TBD on intensity images.
 
 use anyhow::{ensure, Result};
-use faint_core::detect::dp::{DpConfig, DpReport, Method};
+use faint_core::detect::dp::{first_clamped, DpConfig, DpReport, MeritCell, Method};
 use serde::{Deserialize, Serialize};
 
 use super::{drive_with, find_default, json, load, valid, Outcome, Request, XY_POSITION};
@@ -73,8 +73,9 @@ pub(super) fn run_dp(req: &Request, name: &'static str, method: Method) -> Resul
         req.input.display(),
         images.shape
     );
-    let read = cpu() - t;
     let cfg = file.config;
+    refuse_clamped(req, &cfg, &images.data, m, m)?;
+    let read = cpu() - t;
     let mut out = with_dp!(method, file.q_b, &cfg, |det| {
         let mut det = det;
         drive_with(
@@ -88,4 +89,26 @@ pub(super) fn run_dp(req: &Request, name: &'static str, method: Method) -> Resul
     });
     out.read_seconds = read;
     Ok(out)
+}
+
+/// Refuses input the quantiser would clamp (the core clamps and counts such pixels; here
+/// they are an error naming the first one, before the detector runs): frame `k`, pixel
+/// `(x, y)` of a row-major `h x w` frame.
+fn refuse_clamped(req: &Request, cfg: &DpConfig, data: &[f32], h: usize, w: usize) -> Result<()> {
+    let n = (h * w).max(1);
+    for (k, frame) in data.chunks(n).enumerate() {
+        if let Some(i) = first_clamped::<i16>(cfg, frame) {
+            let lim = i16::ZMAX as f32 * cfg.lsb;
+            anyhow::bail!(
+                "{}: frame {k}, pixel (x, y) = ({}, {}) is {}, outside the DP quantiser's range +-{lim} ({} LSB of lsb = {}); normalise the images or raise lsb",
+                req.input.display(),
+                i % w,
+                i / w,
+                frame[i],
+                i16::ZMAX,
+                cfg.lsb
+            );
+        }
+    }
+    Ok(())
 }
