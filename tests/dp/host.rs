@@ -49,12 +49,31 @@ fn rows_of<D: Detector<Frame = [f32]>>(
     rows
 }
 
+/// The default configuration of `name` with `"noise"` replaced (JSON), written to `path`.
+fn config_with_noise(name: &str, noise: serde_json::Value, path: &Path) {
+    let (code, text, err) = faint(&["detect", name, "--print-config"]);
+    assert_eq!(code, 0, "{err}");
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["noise"] = noise;
+    std::fs::write(path, v.to_string()).unwrap();
+}
+
+/// The preset's absolute scale (`DpConfig::dim_point`): the reproduction's detectors.
+fn as_is() -> serde_json::Value {
+    serde_json::json!({"as-is": {"lsb": 0.0625, "sigma": 1.5, "a_design": 3.0}})
+}
+
+/// `faint detect name` with the preset's absolute scale (`"noise": {"as-is": ...}`).
 fn detect(name: &str, input: &Path, out: &Path, truth: &Path) -> Vec<(usize, u32, Vec<u32>)> {
+    let cfg = out.with_extension("json");
+    config_with_noise(name, as_is(), &cfg);
     let (code, stdout, err) = faint(&[
         "detect",
         name,
         "--input",
         s(input),
+        "--config",
+        s(&cfg),
         "--out",
         s(out),
         "--truth",
@@ -188,6 +207,31 @@ fn bad_dp_inputs_are_one_clear_line() {
         &["detect", "dp-arnold", "--input", s(&nan)],
         &["nan.npy", "frame 1, index 7", "NaN"],
     );
+    // No noise to normalise by: a flat file (the robust default needs a scale).
+    let flat = dir.join("flat.npy");
+    write_real_frames(&flat, &[2, 128, 128], &vec![0.5; 2 * 128 * 128]).unwrap();
+    fails(
+        &["detect", "dp-arnold", "--input", s(&flat)],
+        &["flat.npy", "median absolute deviation is 0"],
+    );
+    // A design SNR that is not a positive number.
+    let snr = dir.join("snr.json");
+    config_with_noise(
+        "dp-pulford",
+        serde_json::json!({"robust": {"design_snr": -1.0}}),
+        &snr,
+    );
+    fails(
+        &[
+            "detect",
+            "dp-pulford",
+            "--input",
+            s(&flat),
+            "--config",
+            s(&snr),
+        ],
+        &["snr.json", "design_snr = -1"],
+    );
     // A q_B that is not compiled in, and a method that is not the detector's.
     let cfg = dir.join("cfg.json");
     let mut v: serde_json::Value = serde_json::from_str(&{
@@ -243,18 +287,65 @@ fn bright_file(path: &Path, background: f32) -> Vec<(usize, usize)> {
     (0..40).map(|k| t.pixel(k)).collect()
 }
 
+/// `(frame, x, y)` of every detection of `faint detect name` (default configuration).
+fn ends(name: &str, input: &Path, out: &Path) -> Vec<(usize, String, String)> {
+    let (code, _, err) = faint(&[
+        "detect",
+        name,
+        "--input",
+        s(input),
+        "--out",
+        s(out),
+        "--no-plots",
+    ]);
+    assert_eq!(code, 0, "{name}: {err}");
+    let mut r = csv::Reader::from_path(out.join("detections.csv")).unwrap();
+    r.records()
+        .map(|rec| {
+            let rec = rec.unwrap();
+            (
+                rec[0].parse().unwrap(),
+                rec[5].to_string(),
+                rec[6].to_string(),
+            )
+        })
+        .collect()
+}
+
 /// Regression (the case): a camera-like background of 3000 lay beyond the
 /// quantiser's +-1024 and was clamped silently, so every merit was equal and every
-/// detection was pixel (0, 0) with exit status 0. Now it is one line naming the frame and
-/// the cell.
+/// detection was pixel (0, 0) with exit status 0. Now the default (scale-free) run finds
+/// the target at its pixel in every frame, and the preset's absolute scale
+/// (`"noise": {"as-is": ...}`) is one line naming the frame and the cell.
 #[test]
-fn a_background_beyond_the_quantiser_is_refused_naming_the_cell() {
+fn a_background_of_3000_is_detected_or_refused_never_clamped() {
     let dir = temp("bright");
     let file = dir.join("bright.npy");
-    bright_file(&file, 3000.0);
+    let truth = bright_file(&file, 3000.0);
     let out = dir.join("out");
     for name in ["dp-arnold", "dp-pulford", "dp-second"] {
-        let (code, stdout, err) = faint(&["detect", name, "--input", s(&file), "--out", s(&out)]);
+        let got = ends(name, &file, &dir.join(name));
+        assert_eq!(got.len(), 40, "{name}: one end per frame");
+        for (k, x, y) in &got {
+            let (tx, ty) = truth[*k];
+            assert_eq!(
+                (x.parse::<f32>().unwrap(), y.parse::<f32>().unwrap()),
+                (tx as f32 + 0.5, ty as f32 + 0.5),
+                "{name} frame {k}"
+            );
+        }
+        let cfg = dir.join(format!("{name}.json"));
+        config_with_noise(name, as_is(), &cfg);
+        let (code, stdout, err) = faint(&[
+            "detect",
+            name,
+            "--input",
+            s(&file),
+            "--config",
+            s(&cfg),
+            "--out",
+            s(&out),
+        ]);
         assert_eq!(code, 2, "{name}: {stdout}");
         assert_eq!(err.trim_end().lines().count(), 1, "{err}");
         assert!(
@@ -264,4 +355,78 @@ fn a_background_beyond_the_quantiser_is_refused_naming_the_cell() {
         assert!(!out.exists());
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Scale-free by default: the same file times 10, and plus 3000, gives the same
+/// `(frame, x, y)` of every detection. Times 10 changes each pixel by one f32 rounding
+/// (relative 6e-8), so the SNR-2.5 file of the round trip is used, whose early frames'
+/// best ends are noise tracks. Plus 3000 stores each pixel to 2.4e-4 (the f32 spacing at
+/// 3000), about 1/300 of the `sigma / 32` LSB, so some pixels round to the neighbouring
+/// LSB and close noise tracks could swap; it is checked on the SNR-6 file, whose
+/// target leads in every frame.
+#[test]
+fn scaled_and_offset_copies_give_the_same_detections() {
+    let dir = temp("scale");
+    let file = dir.join("dim.npy");
+    let (code, _, err) = faint(&[
+        "simulate",
+        "dim-point",
+        "--out",
+        s(&file),
+        "--seed",
+        "11",
+        "--snr",
+        "2.5",
+        "--speed",
+        "1",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let read = |p: &Path| faint::host::io::input::read_real_frames(p, 3).unwrap();
+    let f = read(&file);
+    let times10 = dir.join("times10.npy");
+    let data: Vec<f32> = f.data.iter().map(|z| z * 10.0).collect();
+    write_real_frames(&times10, &f.shape, &data).unwrap();
+    let bright = dir.join("bright.npy");
+    bright_file(&bright, 0.0);
+    let b = read(&bright);
+    let plus = dir.join("plus3000.npy");
+    let data: Vec<f32> = b.data.iter().map(|z| z + 3000.0).collect();
+    write_real_frames(&plus, &b.shape, &data).unwrap();
+    for name in ["dp-arnold", "dp-pulford", "dp-second"] {
+        let o = |t: &str| dir.join(format!("{name}-{t}"));
+        let want = ends(name, &file, &o("a"));
+        assert_eq!(want.len(), 40);
+        assert_eq!(ends(name, &times10, &o("b")), want, "{name} x10");
+        let want = ends(name, &bright, &o("c"));
+        assert_eq!(ends(name, &plus, &o("d")), want, "{name} +3000");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The robust estimate is the median and `1.4826 MAD`, which a bright target pixel per
+/// frame does not move: on 40 x 128 x 128 draws of `N(5, 2^2)` its error is about
+/// `2 / sqrt(655360) = 0.0025` (level) and 0.003 (sigma), so 0.02 is 7 standard errors;
+/// a target of 1000 in one pixel per frame moves each by one rank in 655360.
+#[test]
+fn the_robust_noise_estimate_ignores_targets() {
+    let mut rng = Rng::seed_from_u64(8);
+    let mut v: Vec<f32> = (0..40 * 128 * 128)
+        .map(|_| 5.0 + 2.0 * rng.normal())
+        .collect();
+    let (l0, s0) = faint::host::detect::robust_noise(&v).unwrap();
+    assert!(
+        (l0 - 5.0).abs() < 0.02 && (s0 - 2.0).abs() < 0.02,
+        "{l0} {s0}"
+    );
+    for k in 0..40 {
+        v[k * 128 * 128 + 77] = 1000.0;
+    }
+    let (l1, s1) = faint::host::detect::robust_noise(&v).unwrap();
+    assert!(
+        (l1 - l0).abs() < 1e-3 && (s1 - s0).abs() < 1e-3,
+        "{l1} {s1}"
+    );
+    assert_eq!(faint::host::detect::robust_noise(&[]), None);
+    let (l, s) = faint::host::detect::robust_noise(&[1.0, 3.0, 2.0, 10.0]).unwrap();
+    assert_eq!((l, s), (2.5, 1.482_602_218_505_602));
 }

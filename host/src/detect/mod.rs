@@ -8,8 +8,8 @@
 //!
 //! The configuration file is JSON: `{"config": {...}}` holding the core configuration
 //! (e.g. `CrpfConfig`), plus `"particles"` for the particle filters (one of
-//! [`PARTICLES`]), `"estimate_noise"` for the Gaussian comparators and `"q_b"` for
-//! DP-TBD ([`DpFile`]). Unknown keys are rejected; values are checked by the core's own
+//! [`PARTICLES`]), `"estimate_noise"` for the Gaussian comparators and `"q_b"` and
+//! `"noise"` for DP-TBD ([`DpFile`]). Unknown keys are rejected; values are checked by the core's own
 //! `validate`.
 //!
 //! Outputs ([`write()`]): `detections.csv` / `detections.json` (frame, detector, score,
@@ -40,7 +40,7 @@ mod phd;
 mod plots;
 
 pub use doppler::{GaussFile, PARTICLES};
-pub use dp::DpFile;
+pub use dp::{robust_noise, DpFile, DpNoise, DpSettings};
 pub use output::{check_input, read_truth, write, write_plots, Selection, Written};
 pub use plots::default_classic;
 
