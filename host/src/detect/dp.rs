@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{drive_with, find_default, json, load, Outcome, Request, XY_POSITION};
 use crate::io::input::read_real_frames;
-use crate::scenario::dp::with_dp;
+use crate::scenario::dp::{capacity, pad_image, with_dp_sized, CAPACITIES};
 use crate::timing::thread_cpu_seconds as cpu;
 
 /// `1.4826 MAD` estimates a Gaussian's standard deviation (`1 / Phi^-1(3/4)`).
@@ -30,7 +30,7 @@ pub const ROBUST_LSB: f32 = 0.03125;
 pub enum DpNoise {
     /// Scale-free (the default): `z' = (z - median) / (1.4826 MAD)` over every pixel of
     /// the file, then the DP with `sigma = 1`, `a_design = design_snr` and
-    /// `lsb = `[`ROBUST_LSB`] (doubled until no pixel lies beyond `16384 lsb`). Merits
+    /// `lsb = 2^-5` (doubled until no pixel lies beyond `16384 lsb`). Merits
     /// are in units of the estimated noise `sigma`.
     Robust {
         /// Design amplitude as a linear SNR `a / sigma` (eq. 29; the preset's 2.0).
@@ -109,8 +109,8 @@ impl DpSettings {
 }
 
 /// A DP-TBD detector's configuration file: `q_B` (9 or 25, compiled in), how the images
-/// are scaled, and the rest of the core configuration; `M = 128` and `L = 40` are
-/// compiled in.
+/// are scaled, and the rest of the core configuration; `L = 40` is compiled in, and the
+/// image side `M` (128, 256 or 512) is the smallest that holds the images.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DpFile {
@@ -124,7 +124,7 @@ pub struct DpFile {
 
 impl DpFile {
     /// The core configuration before the data are seen (the robust mode's at
-    /// [`ROBUST_LSB`]).
+    /// `lsb = 2^-5`).
     pub fn nominal(&self) -> DpConfig {
         match self.noise {
             DpNoise::Robust { design_snr } => self.config.config(ROBUST_LSB, 1.0, design_snr),
@@ -208,13 +208,14 @@ pub(super) fn run_dp(req: &Request, name: &'static str, method: Method) -> Resul
         f.nominal().validate().map_err(|e| anyhow!("{e}"))
     })?;
     let mut images = read_real_frames(req.input, 3)?;
-    let m = crate::scenario::dp::SIDE;
-    ensure!(
-        images.shape[1..] == [m, m],
-        "{}: images of shape {:?}, the DP detectors are built for (K, {m}, {m})",
-        req.input.display(),
-        images.shape
-    );
+    let (h, w) = (images.shape[1], images.shape[2]);
+    let largest = CAPACITIES[CAPACITIES.len() - 1];
+    let m = capacity(h, w).ok_or_else(|| {
+        anyhow!(
+            "{}: images of {h} x {w} (H x W); the DP detectors take (K, H, W) with H, W up to {largest}",
+            req.input.display()
+        )
+    })?;
     let mut cfg = file.nominal();
     let (mut level, mut sigma) = (0.0, 1.0);
     if let DpNoise::Robust { .. } = file.noise {
@@ -228,7 +229,13 @@ pub(super) fn run_dp(req: &Request, name: &'static str, method: Method) -> Resul
     } else if let DpNoise::AsIs { sigma: s, .. } = file.noise {
         sigma = f64::from(s);
     }
-    refuse_clamped(req, &cfg, &images.data, m, m)?;
+    refuse_clamped(req, &cfg, &images.data, h, w)?;
+    let k = images.frames();
+    let padded = (h, w) != (m, m);
+    if padded {
+        let fill = -((i16::ZMAX - 1) as f32) * cfg.lsb;
+        images.data = pad_image(&images.data, k, h, w, m, fill);
+    }
     let read = cpu() - t;
     let lsb = cfg.lsb;
     let report_json = |r: &DpReport| {
@@ -244,17 +251,23 @@ pub(super) fn run_dp(req: &Request, name: &'static str, method: Method) -> Resul
         })
         .unwrap_or_default()
     };
-    let mut out = with_dp!(method, file.q_b, &cfg, |det| {
+    let n = m * m;
+    let mut out = with_dp_sized!(method, file.q_b, m, &cfg, |det| {
         let mut det = det;
         drive_with(
             name,
             det.as_mut(),
-            (0..images.frames()).map(|k| images.frame(k)),
+            images.data.chunks_exact(n),
             req,
             XY_POSITION,
             report_json,
         )?
     });
+    if padded {
+        // Track ends in the padding (possible only for states held near the merit floor).
+        out.rows
+            .retain(|r| r.state.first() < Some(&(w as f32)) && r.state.get(1) < Some(&(h as f32)));
+    }
     out.read_seconds = read;
     Ok(out)
 }

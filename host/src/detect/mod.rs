@@ -61,8 +61,8 @@ pub enum InputKind {
     PowerCubes,
     /// `(K, Nr, Nv)` float32 `.npy`/`.npz`: one range x velocity power map `|y|^2` per frame.
     PowerMaps,
-    /// `(K, M, M)` float32 `.npy`/`.npz`: one square intensity image per frame (row-major,
-    /// pixel `(x, y)` = (column, row)).
+    /// `(K, H, W)` float32 `.npy`/`.npz`, `H, W <= 512`: one intensity image per frame
+    /// (row-major, pixel `(x, y)` = (column, row)).
     Images,
 }
 
@@ -74,7 +74,7 @@ impl InputKind {
             InputKind::Plots => "CSV scan,amplitude,x,y",
             InputKind::PowerCubes => "(K, R, D, A) float32 .npy/.npz power cubes",
             InputKind::PowerMaps => "(K, Nr, Nv) float32 .npy/.npz range-Doppler power maps |y|^2",
-            InputKind::Images => "(K, 128, 128) float32 .npy/.npz intensity images",
+            InputKind::Images => "(K, H, W) float32 .npy/.npz intensity images, H and W up to 512",
         }
     }
 }
