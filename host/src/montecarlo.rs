@@ -56,7 +56,10 @@ pub const STACK_COPIES: usize = 8;
 
 /// The largest detector the host builds by value, in bytes: the second-order DP-TBD of
 /// the DP reproduction (`scenario::dp::Second25`, 6.3 MB); the PHD host filter is 3.1 MB.
-/// A unit test checks this bound against `size_of` of every detector type the host builds.
+/// A unit test checks this bound against `size_of` of every detector type the host builds
+/// by value. The larger DP detectors of `faint detect` (`scenario::dp::*At256`,
+/// `*At512`, up to 100 MB) are never built by value: `scenario::dp::boxed` zeroes and
+/// configures them in place on the heap (tested on a 256 KiB stack).
 pub const LARGEST_DETECTOR: usize = 7 << 20;
 
 /// Stack of every worker thread faint starts: [`STACK_COPIES`] copies of

@@ -4,8 +4,8 @@
 //! determinism), zero-initialised statics.
 
 use faint::core::detect::dp::{
-    arnold_words, pulford_words, second_order_words, transition_table, ArnoldDp, DpConfig,
-    DpReport, DpTrack, Method, PulfordDp, SecondOrderDp, Transition,
+    arnold_words, first_clamped, pulford_words, second_order_words, transition_table, ArnoldDp,
+    DpConfig, DpReport, DpTrack, Method, PulfordDp, SecondOrderDp, Transition,
 };
 use faint::core::detect::{run, Detector};
 use faint::core::rng::Rng;
@@ -675,4 +675,37 @@ fn static_ram_equals_the_formulas() {
     assert!(second_order_bytes(128, 9, 8, 1) <= 512 * 1024);
     assert!(second_order_bytes(128, 9, 6, 2) <= 512 * 1024);
     assert!(second_order_bytes(128, 9, 7, 2) > 512 * 1024);
+}
+
+/// `first_clamped` is the detectors' own clamping rule: on frames with pixels at, just
+/// inside and just outside `+-ZMAX` LSB (1024 at `lsb = 1/16`), it flags exactly the
+/// frames whose report counts clamped pixels, and the first such pixel. Regression: a
+/// background of 3000 was clamped to 1024 silently, every merit equal, best end (0, 0).
+#[test]
+fn first_clamped_finds_the_pixels_the_quantiser_clamps() {
+    let c = cfg(Method::Arnold);
+    let lim = 16384.0 * c.lsb;
+    let mut d = A9::unconfigured();
+    d.configure(&c, 0).unwrap();
+    let base = frames(41, 1, M).remove(0);
+    let just_out = f32::from_bits(lim.to_bits() + 1);
+    for (at, v, clamps) in [
+        (3, lim, false),
+        (3, -lim, false),
+        (7, just_out, true),
+        (M * M - 1, -just_out, true),
+        (0, 3000.0, true),
+        (5, 1e30, true),
+    ] {
+        let mut z = base.clone();
+        z[at] = v;
+        let r = d.step(&z).unwrap();
+        assert_eq!(r.clamped > 0, clamps, "{v} at {at}");
+        assert_eq!(first_clamped::<i16>(&c, &z), clamps.then_some(at), "{v}");
+    }
+    // The case: every pixel 3000 (+ noise) is clamped; all are flagged.
+    let bright: Vec<f32> = base.iter().map(|z| 3000.0 + z).collect();
+    assert_eq!(first_clamped::<i16>(&c, &bright), Some(0));
+    assert_eq!(d.step(&bright).unwrap().clamped as usize, M * M);
+    assert_eq!(first_clamped::<i16>(&c, &base), None);
 }

@@ -9,7 +9,7 @@
 //! The configuration file is JSON: `{"config": {...}}` holding the core configuration
 //! (e.g. `CrpfConfig`), plus `"particles"` (one of [`PARTICLES`]) and the noise level,
 //! SNR prior and birth settings for the Doppler-frame detectors ([`DopplerFile`]) and
-//! `"q_b"` for DP-TBD ([`DpFile`]). Unknown keys are rejected; values are checked by the core's own
+//! `"q_b"` and `"noise"` for DP-TBD ([`DpFile`]). Unknown keys are rejected; values are checked by the core's own
 //! `validate`.
 //!
 //! Outputs ([`write()`]): `detections.csv` / `detections.json` (frame, detector, score,
@@ -40,7 +40,7 @@ mod phd;
 mod plots;
 
 pub use doppler::{bin_variance, DopplerFile, GaussFile, NoiseLevel, PARTICLES};
-pub use dp::DpFile;
+pub use dp::{robust_noise, DpFile, DpNoise, DpSettings};
 pub use output::{check_input, read_truth, write, write_plots, Selection, Written};
 pub use plots::{
     classic_threshold, clutter_density, default_classic, mht_gamma, PlotFile, DEFAULT_GRID_PFA,
@@ -63,8 +63,8 @@ pub enum InputKind {
     PowerCubes,
     /// `(K, Nr, Nv)` float32 `.npy`/`.npz`: one range x velocity power map `|y|^2` per frame.
     PowerMaps,
-    /// `(K, M, M)` float32 `.npy`/`.npz`: one square intensity image per frame (row-major,
-    /// pixel `(x, y)` = (column, row)).
+    /// `(K, H, W)` float32 `.npy`/`.npz`, `H, W <= 512`: one intensity image per frame
+    /// (row-major, pixel `(x, y)` = (column, row)).
     Images,
 }
 
@@ -76,7 +76,7 @@ impl InputKind {
             InputKind::Plots => "CSV scan,amplitude,x,y",
             InputKind::PowerCubes => "(K, R, D, A) float32 .npy/.npz power cubes",
             InputKind::PowerMaps => "(K, Nr, Nv) float32 .npy/.npz range-Doppler power maps |y|^2",
-            InputKind::Images => "(K, 128, 128) float32 .npy/.npz intensity images",
+            InputKind::Images => "(K, H, W) float32 .npy/.npz intensity images, H and W up to 512",
         }
     }
 }

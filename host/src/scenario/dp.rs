@@ -69,6 +69,46 @@ unsafe impl ZeroValid for Second9 {}
 // SAFETY: as above.
 unsafe impl ZeroValid for Second25 {}
 
+/// Image sides `M` of the host detectors of `faint detect dp-*`, smallest first: an
+/// `H x W` image runs on the smallest that holds `max(H, W)`, padded (see
+/// [`pad_image`]). [`SIDE`] is the preset's.
+pub const CAPACITIES: [usize; 3] = [SIDE, 256, 512];
+
+/// The side `M` of [`CAPACITIES`] an `h x w` image runs on (`None`: larger than the
+/// largest, or empty).
+pub fn capacity(h: usize, w: usize) -> Option<usize> {
+    if h == 0 || w == 0 {
+        return None;
+    }
+    CAPACITIES.iter().copied().find(|&m| h.max(w) <= m)
+}
+
+/// Defines the larger host detectors (only ever built in place by [`boxed`]: they are
+/// larger than a thread's stack).
+macro_rules! sized {
+    ($($name:ident = $ty:ident, $words:ident, $m:literal, $q:literal;)*) => {$(
+        #[doc = concat!("`", stringify!($ty), "` at `M = ", stringify!($m), "`, `q_B = ", stringify!($q), "`.")]
+        pub type $name = $ty<$m, $q, HISTORY, { $words($m, $q, HISTORY) }>;
+        // SAFETY: as for the `M = 128` types above.
+        unsafe impl ZeroValid for $name {}
+    )*};
+}
+
+sized! {
+    Arnold9At256 = ArnoldDp, arnold_words, 256, 9;
+    Arnold25At256 = ArnoldDp, arnold_words, 256, 25;
+    Pulford9At256 = PulfordDp, pulford_words, 256, 9;
+    Pulford25At256 = PulfordDp, pulford_words, 256, 25;
+    Second9At256 = SecondOrderDp, second_order_words, 256, 9;
+    Second25At256 = SecondOrderDp, second_order_words, 256, 25;
+    Arnold9At512 = ArnoldDp, arnold_words, 512, 9;
+    Arnold25At512 = ArnoldDp, arnold_words, 512, 25;
+    Pulford9At512 = PulfordDp, pulford_words, 512, 9;
+    Pulford25At512 = PulfordDp, pulford_words, 512, 25;
+    Second9At512 = SecondOrderDp, second_order_words, 512, 9;
+    Second25At512 = SecondOrderDp, second_order_words, 512, 25;
+}
+
 /// A configured DP detector built on the heap: zeroed in place (the `q_B = 25` second
 /// order is 6.2 MB, more than a thread's stack), then configured with `cfg`.
 pub fn boxed<D: DpTrack + ZeroValid>(cfg: &DpConfig) -> Result<Box<D>> {
@@ -126,6 +166,115 @@ macro_rules! with_dp {
     }};
 }
 pub(crate) use with_dp;
+
+/// Runs `$body` with `$det: Box<_>` the host detector of `$method`, `$qb` (9 or 25) and
+/// image side `$side` (one of [`CAPACITIES`]), configured with `$cfg`; another `q_B` or
+/// side is an error naming it.
+macro_rules! with_dp_sized {
+    ($method:expr, $qb:expr, $side:expr, $cfg:expr, |$det:ident| $body:expr) => {{
+        use faint_core::detect::dp::Method as M_;
+        use $crate::scenario::dp as sdp;
+        match ($method, $qb, $side) {
+            (M_::Arnold, 9, 128) => {
+                let $det = sdp::boxed::<sdp::Arnold9>($cfg)?;
+                $body
+            }
+            (M_::Arnold, 25, 128) => {
+                let $det = sdp::boxed::<sdp::Arnold25>($cfg)?;
+                $body
+            }
+            (M_::Pulford, 9, 128) => {
+                let $det = sdp::boxed::<sdp::Pulford9>($cfg)?;
+                $body
+            }
+            (M_::Pulford, 25, 128) => {
+                let $det = sdp::boxed::<sdp::Pulford25>($cfg)?;
+                $body
+            }
+            (M_::SecondOrder, 9, 128) => {
+                let $det = sdp::boxed::<sdp::Second9>($cfg)?;
+                $body
+            }
+            (M_::SecondOrder, 25, 128) => {
+                let $det = sdp::boxed::<sdp::Second25>($cfg)?;
+                $body
+            }
+            (M_::Arnold, 9, 256) => {
+                let $det = sdp::boxed::<sdp::Arnold9At256>($cfg)?;
+                $body
+            }
+            (M_::Arnold, 25, 256) => {
+                let $det = sdp::boxed::<sdp::Arnold25At256>($cfg)?;
+                $body
+            }
+            (M_::Pulford, 9, 256) => {
+                let $det = sdp::boxed::<sdp::Pulford9At256>($cfg)?;
+                $body
+            }
+            (M_::Pulford, 25, 256) => {
+                let $det = sdp::boxed::<sdp::Pulford25At256>($cfg)?;
+                $body
+            }
+            (M_::SecondOrder, 9, 256) => {
+                let $det = sdp::boxed::<sdp::Second9At256>($cfg)?;
+                $body
+            }
+            (M_::SecondOrder, 25, 256) => {
+                let $det = sdp::boxed::<sdp::Second25At256>($cfg)?;
+                $body
+            }
+            (M_::Arnold, 9, 512) => {
+                let $det = sdp::boxed::<sdp::Arnold9At512>($cfg)?;
+                $body
+            }
+            (M_::Arnold, 25, 512) => {
+                let $det = sdp::boxed::<sdp::Arnold25At512>($cfg)?;
+                $body
+            }
+            (M_::Pulford, 9, 512) => {
+                let $det = sdp::boxed::<sdp::Pulford9At512>($cfg)?;
+                $body
+            }
+            (M_::Pulford, 25, 512) => {
+                let $det = sdp::boxed::<sdp::Pulford25At512>($cfg)?;
+                $body
+            }
+            (M_::SecondOrder, 9, 512) => {
+                let $det = sdp::boxed::<sdp::Second9At512>($cfg)?;
+                $body
+            }
+            (M_::SecondOrder, 25, 512) => {
+                let $det = sdp::boxed::<sdp::Second25At512>($cfg)?;
+                $body
+            }
+            (_, q, m) => anyhow::bail!(
+                "q_b = {q}, M = {m}: q_b must be 9 or 25, M one of {:?}",
+                sdp::CAPACITIES
+            ),
+        }
+    }};
+}
+pub(crate) use with_dp_sized;
+
+/// `h x w` row-major frames (`frames` of them, back to back) copied into the top-left
+/// corner of `m x m` frames, the rest `fill`. With `fill` far below every pixel
+/// (`faint detect` uses `-(ZMAX - 1) lsb`, the lowest value that is not clamped), a
+/// state in the padding is never a better predecessor than the in-image state of its
+/// window unless that one lies `ZMAX` LSB below it (held near the merit floor, far
+/// from every track that can matter), so the results inside are those of the
+/// unpadded recursion (see the test `padding_does_not_change_a_128_run`).
+pub fn pad_image(data: &[f32], frames: usize, h: usize, w: usize, m: usize, fill: f32) -> Vec<f32> {
+    let mut out = vec![fill; frames * m * m];
+    if h == 0 || w == 0 || h > m || w > m {
+        return out;
+    }
+    for (src, dst) in data.chunks_exact(h * w).zip(out.chunks_exact_mut(m * m)) {
+        for (s_row, d_row) in src.chunks_exact(w).zip(dst.chunks_exact_mut(m)) {
+            d_row[..w].copy_from_slice(s_row);
+        }
+    }
+    out
+}
 
 /// The three methods in the order of every table.
 pub const METHODS: [Method; 3] = [Method::Arnold, Method::Pulford, Method::SecondOrder];
@@ -331,6 +480,67 @@ pub struct Run {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The larger detectors are built in place on the heap: all of them configure on a
+    /// thread with a 256 KiB stack, smaller than each (a by-value construction would
+    /// overflow it and abort the test binary). Prints each `size_of`, the numbers of
+    /// docs/dp.md (`cargo test -p faint --lib -- larger_dp --nocapture`).
+    #[test]
+    fn larger_dp_detectors_build_in_place() {
+        fn build<D: DpTrack + ZeroValid>(method: Method, q: usize) -> (String, usize) {
+            let cfg = DpConfig::dim_point(method, 1);
+            let d = boxed::<D>(&cfg).unwrap();
+            assert_eq!(d.frames(), 0);
+            assert!(std::mem::size_of::<D>() > 256 << 10);
+            let name = format!("{} q_B {q} M {}", method.name(), D::SIDE);
+            (name, std::mem::size_of::<D>())
+        }
+        let sizes = std::thread::Builder::new()
+            .stack_size(256 << 10)
+            .spawn(|| {
+                vec![
+                    build::<Arnold9>(Method::Arnold, 9),
+                    build::<Arnold25>(Method::Arnold, 25),
+                    build::<Pulford9>(Method::Pulford, 9),
+                    build::<Pulford25>(Method::Pulford, 25),
+                    build::<Second9>(Method::SecondOrder, 9),
+                    build::<Second25>(Method::SecondOrder, 25),
+                    build::<Arnold9At256>(Method::Arnold, 9),
+                    build::<Arnold25At256>(Method::Arnold, 25),
+                    build::<Pulford9At256>(Method::Pulford, 9),
+                    build::<Pulford25At256>(Method::Pulford, 25),
+                    build::<Second9At256>(Method::SecondOrder, 9),
+                    build::<Second25At256>(Method::SecondOrder, 25),
+                    build::<Arnold9At512>(Method::Arnold, 9),
+                    build::<Arnold25At512>(Method::Arnold, 25),
+                    build::<Pulford9At512>(Method::Pulford, 9),
+                    build::<Pulford25At512>(Method::Pulford, 25),
+                    build::<Second9At512>(Method::SecondOrder, 9),
+                    build::<Second25At512>(Method::SecondOrder, 25),
+                ]
+            })
+            .unwrap()
+            .join()
+            .unwrap();
+        for (name, bytes) in &sizes {
+            println!("{name}: {bytes} B");
+        }
+        assert_eq!(capacity(128, 128), Some(128));
+        assert_eq!(capacity(100, 300), Some(512));
+        assert_eq!(capacity(129, 1), Some(256));
+        assert_eq!(capacity(513, 2), None);
+        assert_eq!(capacity(0, 5), None);
+    }
+
+    #[test]
+    fn padding_keeps_the_image_top_left() {
+        let img: Vec<f32> = (0..2 * 2 * 3).map(|i| i as f32).collect();
+        let p = pad_image(&img, 2, 2, 3, 4, -9.0);
+        assert_eq!(p.len(), 2 * 16);
+        assert_eq!(&p[..8], &[0.0, 1.0, 2.0, -9.0, 3.0, 4.0, 5.0, -9.0]);
+        assert_eq!(&p[8..16], &[-9.0; 8]);
+        assert_eq!(&p[16..20], &[6.0, 7.0, 8.0, -9.0]);
+    }
 
     #[test]
     fn truths_stay_inside_and_move_at_the_speed() {

@@ -37,7 +37,9 @@
 //! ## Bad input
 //! A frame of the wrong length is `Error::LengthMismatch`, a NaN or infinite pixel is
 //! `Error::NonFinite`, both before any state changes. Finite pixels beyond `ZMAX` LSB
-//! (e.g. `1e30`) are clamped and counted in [`DpReport::clamped`]. An image of equal
+//! (e.g. `1e30`) are clamped and counted in [`DpReport::clamped`], a documented recovery
+//! (clamping keeps the recursion monotone); [`first_clamped`] finds such a pixel before a
+//! frame is run, for a caller that must refuse it instead. An image of equal
 //! values gives every interior state the same merit; ties are broken deterministically
 //! (a fixed candidate order, documented per recursion). `L = 0`, a window larger than
 //! the image, a method that is not the detector's, or a bad value are
@@ -552,6 +554,20 @@ impl Quant {
         }
         clamped
     }
+}
+
+/// The index of the first pixel of `frame` that a detector with merit cells `C` and
+/// configuration `cfg` would clamp (`|z / lsb| > C::ZMAX`, the pixels counted in
+/// [`DpReport::clamped`]), or `None`. The same arithmetic as the detectors' quantiser, so
+/// a caller can refuse such a frame before any state changes. NaN is never reported here
+/// (the detectors reject it as `Error::NonFinite`).
+pub fn first_clamped<C: MeritCell>(cfg: &DpConfig, frame: &[f32]) -> Option<usize> {
+    let inv_lsb = 1.0 / cfg.lsb;
+    let zmax = C::ZMAX as f32;
+    frame.iter().position(|&z| {
+        let y = z * inv_lsb;
+        y > zmax || y < -zmax
+    })
 }
 
 /// Checks the frame length against `M x M`.
