@@ -14,11 +14,10 @@ use serde::{Deserialize, Serialize};
 
 use super::{drive_with, find_default, json, load, Outcome, Request, XY_POSITION};
 use crate::io::input::read_real_frames;
+use crate::stats::noise::{median, MAD_TO_STD};
 use crate::scenario::dp::{capacity, pad_image, with_dp_sized, CAPACITIES};
 use crate::timing::thread_cpu_seconds as cpu;
 
-/// `1.4826 MAD` estimates a Gaussian's standard deviation (`1 / Phi^-1(3/4)`).
-const MAD_TO_STD: f64 = 1.482_602_218_505_602;
 
 /// Merit LSB of the scale-free mode: `2^-5` noise `sigma` (raised by powers of two when a
 /// normalised pixel would lie beyond `16384` LSB, i.e. `512 sigma`).
@@ -154,21 +153,6 @@ pub fn robust_noise(data: &[f32]) -> Option<(f64, f64)> {
         *x = (*x - level).abs();
     }
     Some((level, MAD_TO_STD * median(&mut v)?))
-}
-
-/// Median (the mean of the two middle values for an even count), `None` when empty.
-fn median(v: &mut [f64]) -> Option<f64> {
-    let n = v.len();
-    if n == 0 {
-        return None;
-    }
-    let (lo, mid, _) = v.select_nth_unstable_by(n / 2, f64::total_cmp);
-    let hi = *mid;
-    Some(if n % 2 == 1 {
-        hi
-    } else {
-        0.5 * (lo.iter().copied().fold(f64::NEG_INFINITY, f64::max) + hi)
-    })
 }
 
 /// A DP report as one line of `reports.json`, with the scale the run used.

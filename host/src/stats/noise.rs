@@ -8,17 +8,19 @@
 /// `1.4826 MAD` estimates a Gaussian's standard deviation (`1 / Phi^-1(3/4)`).
 pub const MAD_TO_STD: f64 = 1.482_602_218_505_602;
 
-/// The median of `v` (sorted in place); `None` when empty.
+/// The median of `v` (the mean of the two middle values for an even count; `v` is
+/// reordered, in `O(n)`); `None` when empty.
 pub fn median(v: &mut [f64]) -> Option<f64> {
-    if v.is_empty() {
+    let n = v.len();
+    if n == 0 {
         return None;
     }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
+    let (lo, mid, _) = v.select_nth_unstable_by(n / 2, f64::total_cmp);
+    let hi = *mid;
     Some(if n % 2 == 1 {
-        v[n / 2]
+        hi
     } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
+        0.5 * (lo.iter().copied().fold(f64::NEG_INFINITY, f64::max) + hi)
     })
 }
 
