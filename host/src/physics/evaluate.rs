@@ -225,8 +225,10 @@ pub fn run(a: &Args) -> Result<Evaluation> {
             _ => snr_list("0:15:3")?,
         },
     };
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let scratch = Scratch(std::env::temp_dir().join(format!(
-        "faint-evaluate-{}-{}-{}",
+        "faint-evaluate-{}-{call}-{}-{}",
         std::process::id(),
         entry.name,
         a.seed
