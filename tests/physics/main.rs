@@ -7,7 +7,7 @@ mod common;
 
 use common::{assert_one_line_error, faint_quiet as faint, s, temp};
 use faint::host::montecarlo::WORKER_STACK;
-use faint::host::physics::evaluate::{run, Args, Evaluation};
+use faint::host::physics::evaluate::{run, Args, Evaluation, PhaseArg};
 
 fn args(detector: &str, pfa: f64, runs: usize, frames: usize, snr: &str) -> Args {
     Args {
@@ -20,6 +20,8 @@ fn args(detector: &str, pfa: f64, runs: usize, frames: usize, snr: &str) -> Args
         seed: 7,
         config: None,
         out: None,
+        phase: PhaseArg::Random,
+        swerling: 0,
     }
 }
 
@@ -76,6 +78,10 @@ fn bad_arguments_are_refused() {
         ),
         (vec!["evaluate", "jott", "--pfa", "1.5"], "--pfa"),
         (vec!["evaluate", "nope", "--pfa", "0.1"], "unknown detector"),
+        (
+            vec!["evaluate", "jott", "--pfa", "0.1", "--swerling", "2"],
+            "--swerling",
+        ),
         (
             vec!["evaluate", "phd-tbd", "--pfa", "0.1"],
             "no physics simulator",

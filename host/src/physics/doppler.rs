@@ -25,7 +25,8 @@
 //! Phase `phi_k`: [`Phase::Random`] draws it uniform in `[0, 2 pi)` each frame (frames
 //! from separate dwells); [`Phase::Continuous`] carries it on,
 //! `phi_{k+1} = phi_k + 2 pi (fd_k T + fda_k T^2 / 2)` (one coherent signal cut into
-//! frames), from a uniform `phi_0`.
+//! frames), from a uniform `phi_0`; [`Phase::Zero`] sets it to 0 (the presets'
+//! assumption, for diagnosis only).
 //!
 //! Amplitude (Swerling, scan to scan): case 0 `a_k = a`; case 1 `a_k^2` exponential with
 //! mean `a^2`; case 3 `a_k^2` chi-square with 4 degrees of freedom and mean `a^2`.
@@ -57,6 +58,9 @@ pub enum Phase {
     Random,
     /// Continuous across frames (one coherent signal).
     Continuous,
+    /// `phi_k = 0` every frame: what the presets (and the detectors' models) assume; not
+    /// physical, kept to tell a phase mismatch from other causes.
+    Zero,
 }
 
 /// The Doppler-frame simulator's parameters.
@@ -227,6 +231,7 @@ impl DopplerPhysics {
                 let phi = match self.phase {
                     Phase::Random => two_pi * f64::from(rng.uniform()),
                     Phase::Continuous => *phase,
+                    Phase::Zero => 0.0,
                 };
                 let ak = *a * self.swerling.draw(rng);
                 for (n, xn) in x.iter_mut().enumerate() {

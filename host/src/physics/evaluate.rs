@@ -29,7 +29,7 @@ use faint_core::rng::{derive_seed, Rng};
 use serde::Serialize;
 use statrs::distribution::{Beta, ContinuousCDF};
 
-use super::Physics;
+use super::{Phase, Physics, Swerling};
 use crate::calibrate;
 use crate::detect::calibration::Calibration;
 use crate::detect::{self, Entry, Request};
@@ -70,6 +70,24 @@ pub struct Args {
     /// Also write the Pd curve and the row as CSV here.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Carrier phase from frame to frame (Doppler frames): random (independent dwells),
+    /// continuous (one coherent signal) or zero (the presets' assumption; diagnosis only).
+    #[arg(long, value_enum, default_value = "random")]
+    pub phase: PhaseArg,
+    /// Swerling case of the target's amplitude, 0, 1 or 3 (Doppler frames and images).
+    #[arg(long, default_value_t = 0)]
+    pub swerling: u8,
+}
+
+/// `--phase`.
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PhaseArg {
+    /// Uniform per frame.
+    Random,
+    /// Continuous across frames.
+    Continuous,
+    /// Zero every frame.
+    Zero,
 }
 
 /// One point of the Pd curve.
@@ -200,8 +218,26 @@ pub fn run(a: &Args) -> Result<Evaluation> {
     };
     let config: serde_json::Value = serde_json::from_str(&text)
         .with_context(|| format!("--config: not JSON ({})", entry.name))?;
-    let phys = Physics::for_detector(entry.input, &config)
+    let mut phys = Physics::for_detector(entry.input, &config)
         .with_context(|| format!("{}: its input kind", entry.name))?;
+    let swerling = match a.swerling {
+        0 => Swerling::Zero,
+        1 => Swerling::One,
+        3 => Swerling::Three,
+        s => anyhow::bail!("--swerling {s}: must be 0, 1 or 3"),
+    };
+    match &mut phys {
+        Physics::Doppler(p) => {
+            p.swerling = swerling;
+            p.phase = match a.phase {
+                PhaseArg::Random => Phase::Random,
+                PhaseArg::Continuous => Phase::Continuous,
+                PhaseArg::Zero => Phase::Zero,
+            };
+        }
+        Physics::Images(p) => p.swerling = swerling,
+        Physics::Plots(_) => {}
+    }
     let l = match (a.frames, &phys) {
         (Some(l), _) => l,
         (None, Physics::Doppler(_)) => 20,
@@ -298,6 +334,12 @@ pub fn run(a: &Args) -> Result<Evaluation> {
     let mut user_set = format!("--pfa {}", a.pfa);
     if let Some(c) = &a.config {
         user_set.push_str(&format!(", --config {}", c.display()));
+    }
+    if a.phase != PhaseArg::Random {
+        user_set.push_str(&format!(", --phase {:?}", a.phase).to_lowercase());
+    }
+    if a.swerling != 0 {
+        user_set.push_str(&format!(", --swerling {}", a.swerling));
     }
     if a.burn_in > 0 {
         user_set.push_str(&format!(", --burn-in {}", a.burn_in));
