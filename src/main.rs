@@ -42,6 +42,9 @@ enum Command {
     /// Thresholds at a false-alarm probability for a detector, from noise-only data or
     /// from a noise model estimated on a recording (for `faint detect --calibration`).
     Calibrate(faint::host::calibrate::Args),
+    /// One detector on data from the physics simulator of its input kind: calibrated
+    /// Pfa measured, Pd against SNR, the SNR at Pd 0.9 (one Markdown table row).
+    Evaluate(faint::host::physics::evaluate::Args),
     /// Drive detectors with mutated configurations and hostile frames; write the findings.
     Fuzz(faint::host::reliability::cli::FuzzArgs),
     /// Stream plausible frames through detectors without reset; report cost drift and memory.
@@ -204,6 +207,25 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 },
                 a.out.display()
             );
+            Ok(())
+        }
+        Command::Evaluate(a) => {
+            let ev = faint::host::physics::evaluate::run(&a)?;
+            println!("SNR: {}", ev.snr_definition);
+            if let Some(g) = ev.gate {
+                println!("gate: {g} ({})", ev.input);
+            }
+            for c in &ev.curve {
+                println!(
+                    "  SNR {:6.2} dB: Pd {:.3} [{:.3}, {:.3}] (declared anywhere {:.3})",
+                    c.snr_db, c.pd.p, c.pd.lo, c.pd.hi, c.declared.p
+                );
+            }
+            println!("{}", faint::host::physics::evaluate::Evaluation::header());
+            println!("{}", ev.row());
+            if let Some(o) = &a.out {
+                println!("curve written to {}", o.display());
+            }
             Ok(())
         }
         Command::Fuzz(a) => faint::host::reliability::cli::fuzz_command(&a),

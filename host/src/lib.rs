@@ -16,6 +16,7 @@
 //! - [`cli`]: checks and parsers of command-line values shared by every command.
 //! - [`reliability`]: fuzz and soak campaigns over every detector (`faint fuzz`, `faint soak`).
 //! - [`simulate`]: a preset's frames and truth as files, behind `faint simulate <scenario>`.
+//! - [`physics`]: simulators written from the physics, and `faint evaluate` on them.
 
 #![warn(missing_docs)]
 
@@ -25,6 +26,7 @@ pub mod cli;
 pub mod detect;
 pub mod io;
 pub mod montecarlo;
+pub mod physics;
 pub mod reliability;
 pub mod reproduce;
 pub mod scenario;

@@ -1,0 +1,274 @@
+//! A second simulator per input kind, written from the physics and not from the models
+//! the detectors assume (it calls neither `scenario` nor the core's forward models), and
+//! the evaluation harness behind `faint evaluate` ([`evaluate`]).
+//!
+//! - [`doppler`]: Doppler frames (tone + white noise, window, FFT), for crpf, pf-tbd,
+//!   jott, pf-lrt.
+//! - [`plots`]: plot lists of a cell-by-cell square-law detector (Poisson clutter), for
+//!   mht and hough-classic.
+//! - [`images`]: intensity images with a pixel-integrated Gaussian point-spread, for the
+//!   DP detectors.
+//!
+//! Power cubes and power maps have no simulator here yet ([`Physics::for_detector`]
+//! refuses them). Each file's docs state its conventions (DFT sign, bin order, cell and
+//! pixel centres, units); docs/detect.md repeats them under "Conventions".
+
+pub mod doppler;
+pub mod evaluate;
+pub mod images;
+pub mod plots;
+
+use std::path::Path;
+
+use anyhow::{anyhow, bail, Result};
+use faint_core::model::doppler::Window;
+use faint_core::model::plot::Plot;
+use faint_core::rng::Rng;
+use faint_core::Complex32;
+
+use crate::detect::InputKind;
+
+pub use doppler::{DopplerPhysics, Phase};
+pub use images::ImagePhysics;
+pub use plots::PlotPhysics;
+
+/// Swerling amplitude fluctuation, scan to scan (one draw per frame).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Swerling {
+    /// Constant amplitude.
+    Zero,
+    /// Power exponential (chi-square, 2 degrees of freedom), mean 1.
+    One,
+    /// Power chi-square with 4 degrees of freedom, mean 1.
+    Three,
+}
+
+impl Swerling {
+    /// An amplitude factor `f` with `E f^2 = 1` of this law.
+    pub fn draw(self, rng: &mut Rng) -> f64 {
+        match self {
+            Swerling::Zero => 1.0,
+            Swerling::One => f64::from(rng.exponential()).sqrt(),
+            Swerling::Three => {
+                (0.5 * (f64::from(rng.exponential()) + f64::from(rng.exponential()))).sqrt()
+            }
+        }
+    }
+}
+
+/// A simulator for one detector's input kind.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Physics {
+    /// Doppler frames.
+    Doppler(DopplerPhysics),
+    /// Plot lists.
+    Plots(PlotPhysics),
+    /// Images.
+    Images(ImagePhysics),
+}
+
+/// One simulated run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimRun {
+    /// Its frames.
+    pub data: RunData,
+    /// The target's position per frame (truth columns, [`Physics::truth_names`]); empty
+    /// without a target.
+    pub truth: Vec<Vec<f64>>,
+}
+
+/// Frames of one run.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RunData {
+    /// Doppler frames.
+    Complex(Vec<Vec<Complex32>>),
+    /// Real frames, frame-major.
+    Real(Vec<f32>),
+    /// Scans of plots.
+    Plots(Vec<Vec<Plot>>),
+}
+
+/// A field of a detector's configuration JSON (`config.<path>`).
+fn field<T: serde::de::DeserializeOwned>(config: &serde_json::Value, path: &[&str]) -> Result<T> {
+    let mut v = config
+        .get("config")
+        .ok_or_else(|| anyhow!("the configuration has no 'config' object"))?;
+    for p in path {
+        v = v
+            .get(p)
+            .ok_or_else(|| anyhow!("the configuration has no config.{}", path.join(".")))?;
+    }
+    serde_json::from_value(v.clone()).map_err(|e| anyhow!("config.{}: {e}", path.join(".")))
+}
+
+impl Physics {
+    /// The simulator matching a detector's input kind, with the geometry its
+    /// configuration file reads (Doppler: `model.bins`, `model.ts`, `model.window`;
+    /// plots: `area`; images: 128 x 128 and `config.sigma` as the noise std).
+    pub fn for_detector(kind: InputKind, config: &serde_json::Value) -> Result<Self> {
+        let p = match kind {
+            InputKind::DopplerFrames => {
+                let bins: usize = field(config, &["model", "bins"])?;
+                let ts: f32 = field(config, &["model", "ts"])?;
+                let window: Window = field(config, &["model", "window"])?;
+                Physics::Doppler(DopplerPhysics::new(bins, f64::from(ts), window))
+            }
+            InputKind::Plots => Physics::Plots(PlotPhysics::new(field(config, &["area"])?)),
+            InputKind::Images => {
+                let sigma: f32 = field(config, &["sigma"])?;
+                Physics::Images(ImagePhysics {
+                    sigma: f64::from(sigma),
+                    ..ImagePhysics::new(128, 128)
+                })
+            }
+            InputKind::PowerCubes | InputKind::PowerMaps => {
+                bail!("{kind:?}: no physics simulator yet (Doppler frames, plots and images only)")
+            }
+        };
+        p.validate()?;
+        Ok(p)
+    }
+
+    /// Checks the parameters.
+    pub fn validate(&self) -> Result<()> {
+        match self {
+            Physics::Doppler(p) => p.validate(),
+            Physics::Plots(p) => p.validate(),
+            Physics::Images(p) => p.validate(),
+        }
+    }
+
+    /// Names of the truth columns (the detectors' position names).
+    pub fn truth_names(&self) -> &'static [&'static str] {
+        match self {
+            Physics::Doppler(_) => &["fd_hz"],
+            Physics::Plots(_) => &["x_m", "y_m"],
+            Physics::Images(_) => &["x_px", "y_px"],
+        }
+    }
+
+    /// Gate of a correct position (units of the truth columns): one Doppler bin
+    /// `1 / (m ts)` (Hz), 100 m (plots), 2 px (images).
+    pub fn gate(&self) -> f64 {
+        match self {
+            Physics::Doppler(p) => 1.0 / (p.bins as f64 * p.ts),
+            Physics::Plots(_) => 100.0,
+            Physics::Images(_) => 2.0,
+        }
+    }
+
+    /// Distance between an estimated position and the truth (Doppler wraps in the band).
+    pub fn distance(&self, est: &[f64], truth: &[f64]) -> f64 {
+        match self {
+            Physics::Doppler(p) => match (est.first(), truth.first()) {
+                (Some(&e), Some(&t)) => p.wrap(e - t).abs(),
+                _ => f64::INFINITY,
+            },
+            _ => est
+                .iter()
+                .zip(truth)
+                .map(|(e, t)| (e - t) * (e - t))
+                .sum::<f64>()
+                .sqrt(),
+        }
+    }
+
+    /// What `snr_db` means for this kind (for tables).
+    pub fn snr_definition(&self) -> &'static str {
+        match self {
+            Physics::Doppler(_) => {
+                "peak-bin SNR a^2 (sum w)^2 / (sigma^2 sum w^2) (eq. 18 of Lu et al. 2017)"
+            }
+            Physics::Plots(_) => {
+                "mean cell SNR of a Swerling-1 target (Pd = pfa^(1/(1+snr)) per scan)"
+            }
+            Physics::Images(_) => "20 log10(a / sigma), a the spot's total amplitude",
+        }
+    }
+
+    /// Simulates one run of `frames` frames; `snr_db = None` is noise (clutter) only.
+    pub fn simulate(&self, frames: usize, snr_db: Option<f64>, rng: &mut Rng) -> SimRun {
+        match self {
+            Physics::Doppler(p) => {
+                let (f, t) = p.simulate(frames, snr_db.map(|s| p.amplitude(s)), rng);
+                SimRun {
+                    data: RunData::Complex(f),
+                    truth: t.iter().map(|x| vec![x.fd]).collect(),
+                }
+            }
+            Physics::Plots(p) => {
+                let (f, t) = p.simulate(frames, snr_db.map(|s| 10f64.powf(s / 10.0)), rng);
+                SimRun {
+                    data: RunData::Plots(f),
+                    truth: t.iter().map(|x| x.to_vec()).collect(),
+                }
+            }
+            Physics::Images(p) => {
+                let (f, t) =
+                    p.simulate(frames, snr_db.map(|s| p.sigma * 10f64.powf(s / 20.0)), rng);
+                SimRun {
+                    data: RunData::Real(f),
+                    truth: t.iter().map(|x| x.to_vec()).collect(),
+                }
+            }
+        }
+    }
+
+    /// Writes `runs` one after the other as one input file, and (when `truth` is given)
+    /// the truth file `frame,<names>` with frames numbered through the whole file.
+    pub fn write(&self, runs: &[SimRun], path: &Path, truth: Option<&Path>) -> Result<()> {
+        match self {
+            Physics::Doppler(_) => {
+                let frames: Vec<Vec<Complex32>> = runs
+                    .iter()
+                    .flat_map(|r| match &r.data {
+                        RunData::Complex(f) => f.clone(),
+                        _ => Vec::new(),
+                    })
+                    .collect();
+                crate::io::output::write_complex_frames(path, &frames)?;
+            }
+            Physics::Plots(_) => {
+                let scans: Vec<Vec<Plot>> = runs
+                    .iter()
+                    .flat_map(|r| match &r.data {
+                        RunData::Plots(f) => f.clone(),
+                        _ => Vec::new(),
+                    })
+                    .collect();
+                crate::io::output::write_plots(path, &scans)?;
+            }
+            Physics::Images(p) => {
+                let data: Vec<f32> = runs
+                    .iter()
+                    .flat_map(|r| match &r.data {
+                        RunData::Real(f) => f.clone(),
+                        _ => Vec::new(),
+                    })
+                    .collect();
+                let k = data.len() / (p.width * p.height).max(1);
+                crate::io::output::write_real_frames(path, &[k, p.height, p.width], &data)?;
+            }
+        }
+        if let Some(tp) = truth {
+            let mut text = format!("frame,{}\n", self.truth_names().join(","));
+            let mut first = 0usize;
+            for r in runs {
+                for (k, row) in r.truth.iter().enumerate() {
+                    let cols: Vec<String> = row.iter().map(|v| format!("{v}")).collect();
+                    text.push_str(&format!("{},{}\n", first + k, cols.join(",")));
+                }
+                first += match &r.data {
+                    RunData::Complex(f) => f.len(),
+                    RunData::Plots(f) => f.len(),
+                    RunData::Real(f) => match self {
+                        Physics::Images(p) => f.len() / (p.width * p.height).max(1),
+                        _ => 0,
+                    },
+                };
+            }
+            crate::io::write_text(tp, &text)?;
+        }
+        Ok(())
+    }
+}
