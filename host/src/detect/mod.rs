@@ -42,6 +42,7 @@ mod plots;
 pub use doppler::{GaussFile, PARTICLES};
 pub use dp::DpFile;
 pub use output::{check_input, read_truth, write, write_plots, Selection, Written};
+pub use phd::{default_phd_file, normalise_frame, Noise, PhdFile, PhdSnr};
 pub use plots::default_classic;
 
 use cbmember::{default_cbmember, run_cbmember};
