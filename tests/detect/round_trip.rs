@@ -212,6 +212,8 @@ fn phd_detectors_round_trip() {
     for frame in truth.iter().take(7) {
         let mut c = Vec::new();
         sc.cube(frame, &mut cube_rng, &mut c);
+        // `faint detect`'s default divides each cube by its noise power.
+        faint::host::detect::normalise_frame(&mut c, &mut Vec::new()).unwrap();
         cubes.push(c);
     }
     for (name, v) in [
@@ -219,7 +221,7 @@ fn phd_detectors_round_trip() {
         ("pso-phd-kmeans", Variant::PsoKMeans),
         ("pso-phd-dbscan", Variant::PsoDbscan),
     ] {
-        let cfg = sc.config(v);
+        let cfg = faint::host::detect::default_phd_file(v).effective().unwrap();
         let cubes = cubes.clone();
         let want = faint::host::montecarlo::on_worker_stack(move || {
             let mut f = Box::new(HostFilter::new(cfg, DET_SEED).unwrap());
