@@ -150,3 +150,61 @@ fn detections_do_not_depend_on_the_input_scale() {
         }
     }
 }
+
+/// The scale-free file refuses contradictions with one line naming the value, and a
+/// frame without a noise level.
+#[test]
+fn scale_settings_refuse_contradictions() {
+    use faint::host::detect::Noise;
+    let f = default_phd_file(Variant::PhdTbd);
+    assert!(f.effective().is_ok());
+    let mut g = f.clone();
+    g.config.noise_var = 1.0;
+    let e = g.effective().unwrap_err().to_string();
+    assert!(
+        e.contains("config.noise_var") && e.contains("snr_db"),
+        "{e}"
+    );
+    let mut g = f.clone();
+    g.config.birth.intensity = [1.0, 2.0];
+    let e = g.effective().unwrap_err().to_string();
+    assert!(e.contains("config.birth.intensity"), "{e}");
+    let mut g = f.clone();
+    g.noise = Noise::AsIs;
+    let e = g.effective().unwrap_err().to_string();
+    assert!(e.contains("snr_db is only used"), "{e}");
+    g.snr_db = None;
+    assert!(
+        g.effective().is_ok(),
+        "as-is without snr_db takes the config as it is"
+    );
+    let mut g = f.clone();
+    g.snr_db = None;
+    assert!(g
+        .effective()
+        .unwrap_err()
+        .to_string()
+        .contains("needs snr_db"));
+    for bad in [
+        [f32::NAN, 1.0],
+        [5.0, 4.0],
+        [1.0, f32::INFINITY],
+        [1.0, 300.0],
+    ] {
+        let mut g = f.clone();
+        g.snr_db.as_mut().unwrap().birth = bad;
+        let e = g.effective().unwrap_err().to_string();
+        assert!(e.contains("snr_db.birth"), "{bad:?}: {e}");
+    }
+    let mut zero = vec![0.0f32; 101];
+    zero[3] = 5.0;
+    assert_eq!(normalise_frame(&mut zero, &mut Vec::new()), Err(0.0));
+    assert_eq!(zero[3], 5.0, "a refused frame is unchanged");
+    // Exponential powers of mean 4: the estimate is within 5 % (the median of n
+    // exponentials of mean mu has standard deviation mu / sqrt(n), 1 % of the median
+    // mu ln 2 at n = 20 001, so 5 % is 5 standard deviations).
+    let mut rng = Rng::seed_from_u64(9);
+    let mut v: Vec<f32> = (0..20_001).map(|_| 4.0 * rng.exponential()).collect();
+    let n = normalise_frame(&mut v, &mut Vec::new()).unwrap();
+    assert!((n / 4.0 - 1.0).abs() < 0.05, "{n}");
+}

@@ -172,7 +172,9 @@ pub(super) fn default_phd(v: Variant) -> String {
     json(&default_phd_file(v))
 }
 
-/// The default configuration file of `v` (see [`default_phd`]).
+/// The default configuration file of `v`: the six-targets preset's filter with births
+/// over the whole cube ([`BirthMode::Region`]) and the input normalised to unit noise
+/// power (`"noise": "estimate"`).
 pub fn default_phd_file(v: Variant) -> PhdFile {
     let mut config = SixTargets::new(9.0).config(v);
     let s = DEFAULT_SNR;
