@@ -221,7 +221,9 @@ fn phd_detectors_round_trip() {
         ("pso-phd-kmeans", Variant::PsoKMeans),
         ("pso-phd-dbscan", Variant::PsoDbscan),
     ] {
-        let cfg = faint::host::detect::default_phd_file(v).effective().unwrap();
+        let cfg = faint::host::detect::default_phd_file(v)
+            .effective()
+            .unwrap();
         let cubes = cubes.clone();
         let want = faint::host::montecarlo::on_worker_stack(move || {
             let mut f = Box::new(HostFilter::new(cfg, DET_SEED).unwrap());
