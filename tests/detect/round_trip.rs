@@ -338,16 +338,17 @@ fn cbmember_detectors_round_trip() {
     for (k, t) in sc.truth().iter().take(6).enumerate() {
         let mut m = Vec::new();
         src.power(&sc, t, k, &mut map_rng, &mut m);
+        // `faint detect`'s default divides each map by its noise power.
+        faint::host::detect::normalise_frame(&mut m, &mut Vec::new()).unwrap();
         maps.push(m);
     }
     for (name, model) in [
         ("cbmember", PointModel::Joint),
         ("cbmember-doppler", PointModel::DopplerOnly),
     ] {
-        let cfg = CbmemberConfig {
-            model,
-            ..CbmemberConfig::rotor_uav()
-        };
+        let cfg: CbmemberConfig = faint::host::detect::default_cbmember_file(model)
+            .effective()
+            .unwrap();
         let maps = maps.clone();
         let want = faint::host::montecarlo::on_worker_stack(move || {
             let mut f = Box::new(Cbm::new(cfg, DET_SEED).unwrap());

@@ -39,6 +39,7 @@ mod output;
 mod phd;
 mod plots;
 
+pub use cbmember::{default_cbmember_file, CbmemberFile, CbmemberSnr};
 pub use doppler::{GaussFile, PARTICLES};
 pub use dp::DpFile;
 pub use output::{check_input, read_truth, write, write_plots, Selection, Written};
