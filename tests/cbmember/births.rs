@@ -128,3 +128,31 @@ fn detections_do_not_depend_on_the_input_scale() {
         }
     }
 }
+
+/// `birth.rho_db` is validated, and the file refuses an edited scale value.
+#[test]
+fn scale_settings_are_validated() {
+    use faint::core::detect::Validate;
+    let f = default_cbmember_file(PointModel::Joint);
+    let mut c = f.effective().unwrap();
+    for bad in [
+        [f32::NAN, 1.0],
+        [5.0, 4.0],
+        [0.0, f32::INFINITY],
+        [0.0, 301.0],
+    ] {
+        c.birth.rho_db = Some(bad);
+        assert!(c.validate().is_err(), "{bad:?}");
+    }
+    let mut g = f.clone();
+    g.config.gain = 1.0e19;
+    let e = g.effective().unwrap_err().to_string();
+    assert!(e.contains("config.gain") && e.contains("snr_db"), "{e}");
+    let mut g = f.clone();
+    g.snr_db = None;
+    assert!(g
+        .effective()
+        .unwrap_err()
+        .to_string()
+        .contains("needs snr_db"));
+}

@@ -208,3 +208,31 @@ fn scale_settings_refuse_contradictions() {
     let n = normalise_frame(&mut v, &mut Vec::new()).unwrap();
     assert!((n / 4.0 - 1.0).abs() < 0.05, "{n}");
 }
+
+/// The region birth mode is validated: 1..=64 peaks, a finite non-negative tangential
+/// spread; it needs no birth component.
+#[test]
+fn region_birth_mode_is_validated() {
+    use faint::core::detect::phd::{BirthMode, MAX_REGION_CELLS};
+    use faint::core::detect::Validate;
+    let mut c = default_phd_file(Variant::PhdTbd).effective().unwrap();
+    assert_eq!(c.birth.n_components, 0);
+    assert!(c.validate().is_ok());
+    for (cells, t) in [
+        (0, 40.0),
+        (MAX_REGION_CELLS + 1, 40.0),
+        (8, -1.0),
+        (8, f32::NAN),
+    ] {
+        c.birth.mode = BirthMode::Region {
+            cells,
+            tangential_std: t,
+        };
+        assert!(c.validate().is_err(), "{cells} {t}");
+    }
+    c.birth.mode = BirthMode::Gaussian;
+    assert!(
+        c.validate().is_err(),
+        "the Gaussian mixture needs a component"
+    );
+}
