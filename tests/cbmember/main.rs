@@ -2,6 +2,7 @@
 //! its measurement model, and the reproduction's command line. One test binary for the
 //! family.
 
+mod births;
 mod cli;
 #[path = "../common/cli.rs"]
 mod common;

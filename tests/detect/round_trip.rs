@@ -364,6 +364,8 @@ fn phd_detectors_round_trip() {
     for frame in truth.iter().take(7) {
         let mut c = Vec::new();
         sc.cube(frame, &mut cube_rng, &mut c);
+        // `faint detect`'s default divides each cube by its noise power.
+        faint::host::detect::normalise_frame(&mut c).unwrap();
         cubes.push(c);
     }
     for (name, v) in [
@@ -371,7 +373,9 @@ fn phd_detectors_round_trip() {
         ("pso-phd-kmeans", Variant::PsoKMeans),
         ("pso-phd-dbscan", Variant::PsoDbscan),
     ] {
-        let cfg = sc.config(v);
+        let cfg = faint::host::detect::default_phd_file(v)
+            .effective()
+            .unwrap();
         let cubes = cubes.clone();
         let want = faint::host::montecarlo::on_worker_stack(move || {
             let mut f = Box::new(HostFilter::new(cfg, DET_SEED).unwrap());
@@ -544,16 +548,17 @@ fn cbmember_detectors_round_trip() {
     for (k, t) in sc.truth().iter().take(6).enumerate() {
         let mut m = Vec::new();
         src.power(&sc, t, k, &mut map_rng, &mut m);
+        // `faint detect`'s default divides each map by its noise power.
+        faint::host::detect::normalise_frame(&mut m).unwrap();
         maps.push(m);
     }
     for (name, model) in [
         ("cbmember", PointModel::Joint),
         ("cbmember-doppler", PointModel::DopplerOnly),
     ] {
-        let cfg = CbmemberConfig {
-            model,
-            ..CbmemberConfig::rotor_uav()
-        };
+        let cfg: CbmemberConfig = faint::host::detect::default_cbmember_file(model)
+            .effective()
+            .unwrap();
         let maps = maps.clone();
         let want = faint::host::montecarlo::on_worker_stack(move || {
             let mut f = Box::new(Cbm::new(cfg, DET_SEED).unwrap());

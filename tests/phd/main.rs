@@ -3,6 +3,7 @@
 //! reproduction's command line. One test binary for the family.
 
 mod algorithms;
+mod births;
 mod cli;
 #[path = "../common/cli.rs"]
 mod common;

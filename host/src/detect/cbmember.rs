@@ -1,22 +1,125 @@
 //! CBMeMBer TBD on range x velocity power maps.
+//!
+//! The configuration file is `{"noise", "snr_db", "config"}` as for the PHD family
+//! ([`super::phd`]): with `"noise": "estimate"` (the default) every map is divided by its
+//! noise power (median pixel power over `ln 2`), `config.noise_var` is `0.5`,
+//! `config.gain` makes `rho` the linear peak SNR (eq. 19) at the map's centre range, and
+//! births draw `rho = 10^(U[lo, hi] / 10)` from `snr_db.birth`; `"noise": "as-is"` takes
+//! the map and `config` in absolute units (the preset).
 
-use anyhow::{anyhow, ensure, Result};
-use faint_core::detect::cbmember::CbmemberConfig;
-use faint_core::detect::Detector;
+use anyhow::{anyhow, bail, ensure, Result};
+use faint_core::detect::cbmember::{gain_for_snr, BirthPlacement, CbmemberConfig};
+use faint_core::detect::{Detector, Validate};
 use faint_core::model::range_doppler::PointModel;
+use serde::{Deserialize, Serialize};
 
-use super::{drive, find_default, json, load, valid, Outcome, Plain, Request};
+use super::phd::normalise;
+use super::{drive, find_default, json, load, NoiseLevel, Outcome, Request};
 use crate::io::input::read_real_frames;
 use crate::scenario::cbmember::HostFilter as CbmemberHost;
 use crate::timing::thread_cpu_seconds as cpu;
 
+/// Scale-dependent values of the CBMeMBer configuration in dB over the noise power.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CbmemberSnr {
+    /// Birth peak SNR (eq. 19) `U[lo, hi]` dB.
+    pub birth: [f32; 2],
+}
+
+/// `faint detect`'s configuration file for CBMeMBer.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CbmemberFile {
+    /// The input's scale (`"estimate"` or `"as-is"`).
+    #[serde(default)]
+    pub noise: NoiseLevel,
+    /// SNR values (required with `"estimate"`, refused with `"as-is"`).
+    #[serde(default)]
+    pub snr_db: Option<CbmemberSnr>,
+    /// The core configuration.
+    pub config: CbmemberConfig,
+}
+
+/// Default birth SNR: -5 to 15 dB (the paper's Pd sweep lies around 0 dB).
+pub const DEFAULT_CBMEMBER_SNR: CbmemberSnr = CbmemberSnr {
+    birth: [-5.0, 15.0],
+};
+
+/// `gain` that makes `rho` the linear peak SNR at the centre range of `c`'s map with
+/// `noise_var = 0.5`.
+fn unit_gain(c: &CbmemberConfig) -> f32 {
+    let g = c.geometry;
+    let centre = g.range_start + 0.5 * g.n_range as f32 * g.range_bin;
+    gain_for_snr(0.0, centre, 1.0, 0.5)
+}
+
+impl CbmemberFile {
+    /// The configuration the filter runs (see the module doc). Errors: a value `snr_db`
+    /// sets that differs in `config`, `snr_db` with `"as-is"` or missing with
+    /// `"estimate"`, a non-finite or inverted dB range.
+    pub fn effective(&self) -> Result<CbmemberConfig> {
+        let c = self.config;
+        match (self.noise, self.snr_db) {
+            (NoiseLevel::AsIs, None) => {}
+            (NoiseLevel::AsIs, Some(_)) => {
+                bail!(
+                    "snr_db is only used with \"noise\": \"estimate\"; remove it or the noise line"
+                )
+            }
+            (NoiseLevel::Estimate, None) => {
+                bail!("\"noise\": \"estimate\" needs snr_db {{\"birth\": [lo, hi]}}")
+            }
+            (NoiseLevel::Estimate, Some(s)) => {
+                let [lo, hi] = s.birth;
+                ensure!(
+                    lo.is_finite() && hi.is_finite() && lo <= hi && hi <= 250.0,
+                    "snr_db.birth must be finite dB with lo <= hi <= 250, got [{lo}, {hi}]"
+                );
+                let gain = unit_gain(&c);
+                for (name, same) in [
+                    ("config.noise_var", c.noise_var == 0.5),
+                    ("config.gain", c.gain == gain),
+                    ("config.birth.rho_db", c.birth.rho_db == Some(s.birth)),
+                ] {
+                    ensure!(
+                        same,
+                        "{name} is set by \"noise\": \"estimate\" and snr_db (noise_var 0.5, \
+                         gain {gain}, birth.rho_db {:?}); edit snr_db, or use \"noise\": \"as-is\"",
+                        s.birth
+                    );
+                }
+            }
+        }
+        c.validate().map_err(|e| anyhow!("{e}"))?;
+        Ok(c)
+    }
+}
+
+/// The default configuration file for `model`: the rotor-UAV filter with births placed
+/// from the data ([`BirthPlacement::RangePeak`]) and SNR-relative power.
+pub fn default_cbmember_file(model: PointModel) -> CbmemberFile {
+    let mut c = CbmemberConfig {
+        model,
+        ..CbmemberConfig::rotor_uav()
+    };
+    let s = DEFAULT_CBMEMBER_SNR;
+    c.noise_var = 0.5;
+    c.gain = unit_gain(&c);
+    c.birth.rho_db = Some(s.birth);
+    c.birth.placement = BirthPlacement::RangePeak;
+    c.birth.range[1] = c.spread.zeta_r / 2.0;
+    // rho is the linear SNR: a random walk of 5 % of a 0 dB target per frame.
+    c.process.rho = 0.05;
+    CbmemberFile {
+        noise: NoiseLevel::Estimate,
+        snr_db: Some(s),
+        config: c,
+    }
+}
+
 pub(super) fn default_cbmember(model: PointModel) -> String {
-    json(&Plain {
-        config: CbmemberConfig {
-            model,
-            ..CbmemberConfig::rotor_uav()
-        },
-    })
+    json(&default_cbmember_file(model))
 }
 
 pub(super) fn run_cbmember(
@@ -29,10 +132,10 @@ pub(super) fn run_cbmember(
         PointModel::Joint => find_default("cbmember"),
         PointModel::DopplerOnly => find_default("cbmember-doppler"),
     };
-    let file: Plain<CbmemberConfig> =
-        load(req, default, |f: &Plain<CbmemberConfig>| valid(&f.config))?;
-    let maps = read_real_frames(req.input, 3)?;
-    let g = file.config.geometry;
+    let file: CbmemberFile = load(req, default, |f: &CbmemberFile| f.effective().map(|_| ()))?;
+    let cfg = file.effective()?;
+    let mut maps = read_real_frames(req.input, 3)?;
+    let g = cfg.geometry;
     let want = [g.n_range, g.n_velocity];
     ensure!(
         maps.shape[1..] == want,
@@ -41,8 +144,10 @@ pub(super) fn run_cbmember(
         &maps.shape[1..],
         want
     );
+    if file.noise == NoiseLevel::Estimate {
+        normalise(&mut maps, &req.input.display().to_string())?;
+    }
     let read = cpu() - t;
-    let cfg = file.config;
     let mut det =
         crate::montecarlo::on_worker_stack(move || CbmemberHost::new(cfg, 0).map(Box::new))
             .map_err(|e| anyhow!("{e}"))?;

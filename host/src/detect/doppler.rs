@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use std::path::Path;
 
-use super::{drive, find_default, json, load, valid, InputView, Outcome, Request};
+use super::{drive, find_default, json, load, valid, InputView, NoiseLevel, Outcome, Request};
 use crate::io::input::{read_complex_frames, Frames};
 use crate::stats::noise::exponential_mean;
 use crate::timing::thread_cpu_seconds as cpu;
@@ -20,19 +20,6 @@ use crate::timing::thread_cpu_seconds as cpu;
 /// Particle counts the particle-filter detectors are built for (the capacity is a
 /// compile-time constant of the core).
 pub const PARTICLES: [usize; 4] = [1000, 2000, 4000, 6000];
-
-/// Where the noise level of the input comes from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum NoiseLevel {
-    /// Estimated from the input ([`bin_variance`]) and divided out: the frames are
-    /// scaled to unit time-domain noise variance, the level every amplitude of the
-    /// configuration is in units of (the default).
-    Estimate,
-    /// The input's own units: the configuration's absolute amplitudes (and the Gaussian
-    /// comparators' `config.noise_var`) are used as they are.
-    AsIs,
-}
 
 /// A Doppler-frame detector's configuration file (CRPF-TBD: `C = CrpfConfig`; the
 /// Gaussian comparators: `C = GaussConfig`).

@@ -14,10 +14,9 @@ use serde::{Deserialize, Serialize};
 
 use super::{drive_with, find_default, json, load, Outcome, Request, XY_POSITION};
 use crate::io::input::read_real_frames;
-use crate::stats::noise::{median, MAD_TO_STD};
 use crate::scenario::dp::{capacity, pad_image, with_dp_sized, CAPACITIES};
+use crate::stats::noise::{median, MAD_TO_STD};
 use crate::timing::thread_cpu_seconds as cpu;
-
 
 /// Merit LSB of the scale-free mode: `2^-5` noise `sigma` (raised by powers of two when a
 /// normalised pixel would lie beyond `16384` LSB, i.e. `512 sigma`).

@@ -39,9 +39,11 @@ mod output;
 mod phd;
 mod plots;
 
-pub use doppler::{bin_variance, DopplerFile, GaussFile, NoiseLevel, PARTICLES};
+pub use cbmember::{default_cbmember_file, CbmemberFile, CbmemberSnr};
+pub use doppler::{bin_variance, DopplerFile, GaussFile, PARTICLES};
 pub use dp::{robust_noise, DpFile, DpNoise, DpSettings};
 pub use output::{check_input, read_truth, write, write_plots, Selection, Written};
+pub use phd::{default_phd_file, normalise_frame, PhdFile, PhdSnr};
 pub use plots::{
     classic_threshold, clutter_density, default_classic, mht_gamma, PlotFile, DEFAULT_GRID_PFA,
 };
@@ -51,6 +53,19 @@ use doppler::{default_crpf, default_gauss, run_crpf, run_gauss};
 use dp::{default_dp, run_dp};
 use phd::{default_phd, run_phd};
 use plots::{default_hough, default_mht, run_classic, run_mht};
+
+/// Where the noise level of an input comes from (the `"noise"` key of the Doppler, PHD
+/// and CBMeMBer configuration files; DP-TBD's [`DpNoise`] also carries its units).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum NoiseLevel {
+    /// Estimated robustly from the input ([`crate::stats::noise`]) and divided out, so
+    /// the configuration's scale-dependent values are SNRs over it (the default).
+    #[default]
+    Estimate,
+    /// The input's own units: the configuration's absolute values are used as they are.
+    AsIs,
+}
 
 /// What a detector reads, one frame at a time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

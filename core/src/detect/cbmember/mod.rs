@@ -50,7 +50,7 @@ use crate::existence::ExistenceMarkov;
 use crate::math;
 use crate::model::range_doppler::{
     log_lr_blocked, log_lr_exact, peak_snr, point_velocities, BlockMap, Dequant, Kernel,
-    PointModel, PowerMap, RdGeometry, RdSpread, MAX_BLADES, MAX_POINTS, MAX_VELOCITY_BINS,
+    PointModel, PowerMap, RdGeometry, RdSpread, KAPPA, MAX_BLADES, MAX_POINTS, MAX_VELOCITY_BINS,
 };
 use crate::particles::{gather_resized_in_place, resample, Scheme};
 use crate::rng::Rng;
@@ -115,6 +115,25 @@ pub struct ProcessNoise {
     pub blade_move: f32,
 }
 
+/// Where birth particles' range and velocity come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "snake_case")
+)]
+pub enum BirthPlacement {
+    /// `r ~ N(range)`, `v ~ N(velocity)` (Table 2, the paper).
+    #[default]
+    Prior,
+    /// From the previous frame: `r ~ N(r_peak, range[1]^2)` around the peak of the range
+    /// profile (row sums of the map summed over `+-zeta_r`, rows within `KAPPA zeta_r` of
+    /// a reported component skipped), `v ~ U` over the whole velocity axis (the body's
+    /// Doppler is not taken from the map: a blade can outshine it). Prior before the
+    /// first frame.
+    RangePeak,
+}
+
 /// Birth density: the initial density of Table 2, `V`, `omega`, `theta` uniform.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(
@@ -143,6 +162,13 @@ pub struct BirthDensity {
     /// `theta + omega k eps` (a rotor-phase prior referenced to the first frame; with
     /// point ranges for `V`, `omega`, `theta` this is the paper's "micro-Doppler known").
     pub phase_from_frame0: bool,
+    /// Range and velocity placement (default: the prior).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub placement: BirthPlacement,
+    /// `rho = 10^(U[lo, hi] / 10)` instead of `N(rho)` (a log-uniform SNR prior when
+    /// `gain` makes `rho` the linear SNR; default `None`).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub rho_db: Option<[f32; 2]>,
 }
 
 /// Runtime configuration.
@@ -246,6 +272,8 @@ impl CbmemberConfig {
                 omega: [0.03 * math::PI, 0.09 * math::PI],
                 theta: [0.0, 2.0 * math::PI],
                 phase_from_frame0: false,
+                placement: BirthPlacement::Prior,
+                rho_db: None,
             },
             blades: 2,
             estimate_blades: false,
@@ -307,6 +335,11 @@ impl Validate for CbmemberConfig {
         for m in [b.range, b.velocity, b.rho] {
             if !m[0].is_finite() || !nonneg(m[1]) {
                 return Err(Error::InvalidConfig("birth mean / std"));
+            }
+        }
+        if let Some([lo, hi]) = b.rho_db {
+            if !(lo.is_finite() && hi.is_finite() && lo <= hi && hi <= 300.0) {
+                return Err(Error::InvalidConfig("birth.rho_db (lo <= hi <= 300)"));
             }
         }
         for u in [b.blade_speed, b.omega, b.theta] {
@@ -409,6 +442,9 @@ pub struct CbmemberTbd<const C: usize, const P: usize, const S: usize, F: ?Sized
     frames: u32,
     reported: [u16; C],
     n_reported: usize,
+    /// Range of the previous frame's profile peak ([`BirthPlacement::RangePeak`]).
+    birth_peak: f32,
+    has_peak: bool,
     _frame: PhantomData<fn(&F)>,
 }
 
@@ -431,6 +467,8 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized> Clone for Cbmemb
             frames: self.frames,
             reported: self.reported,
             n_reported: self.n_reported,
+            birth_peak: self.birth_peak,
+            has_peak: self.has_peak,
             _frame: PhantomData,
         }
     }
@@ -588,16 +626,37 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
     }
 
     /// One particle from the birth density (`frame`: index of the frame being processed).
-    fn birth_particle(cfg: &CbmemberConfig, frame: u32, rng: &mut Rng) -> [f32; DIM] {
+    fn birth_particle(
+        cfg: &CbmemberConfig,
+        frame: u32,
+        peak: Option<f32>,
+        rng: &mut Rng,
+    ) -> [f32; DIM] {
         let b = &cfg.birth;
         let blades = if cfg.estimate_blades {
             1 + rng.below(MAX_BLADES as u32)
         } else {
             cfg.blades
         };
-        let r = rng.gaussian(b.range[0], b.range[1]);
-        let v = rng.gaussian(b.velocity[0], b.velocity[1]);
-        let rho = rng.gaussian(b.rho[0], b.rho[1]).abs();
+        let (r, v) = match peak {
+            Some(p) => {
+                let g = &cfg.geometry;
+                let r = rng.gaussian(p, b.range[1]);
+                let v0 = g.velocity_start;
+                (
+                    r,
+                    rng.uniform_range(v0, v0 + g.n_velocity as f32 * g.velocity_bin),
+                )
+            }
+            None => (
+                rng.gaussian(b.range[0], b.range[1]),
+                rng.gaussian(b.velocity[0], b.velocity[1]),
+            ),
+        };
+        let rho = match b.rho_db {
+            Some([lo, hi]) => math::powf(10.0, rng.uniform_range(lo, hi) / 10.0),
+            None => rng.gaussian(b.rho[0], b.rho[1]).abs(),
+        };
         let spread = rng.uniform_range(b.blade_speed[0], b.blade_speed[1]);
         let omega = rng.uniform_range(b.omega[0], b.omega[1]);
         let mut theta = rng.uniform_range(b.theta[0], b.theta[1]);
@@ -666,13 +725,17 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
         }
 
         // 2. Birth.
+        let peak = match cfg.birth.placement {
+            BirthPlacement::RangePeak if self.has_peak => Some(self.birth_peak),
+            _ => None,
+        };
         if let Some(k) = Self::birth_slot(&self.comps, cfg.birth.existence) {
             let id = self.next_id;
             self.next_id = self.next_id.wrapping_add(1).max(1);
             if let Some(c) = self.comps.get_mut(k) {
                 let n = cfg.birth.particles.min(P);
                 for x in c.x.iter_mut().take(n) {
-                    *x = Self::birth_particle(&cfg, self.frames, &mut self.rng);
+                    *x = Self::birth_particle(&cfg, self.frames, peak, &mut self.rng);
                 }
                 let w = 1.0 / n.max(1) as f32;
                 c.w.iter_mut().take(n).for_each(|v| *v = w);
@@ -801,8 +864,50 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
             }
         }
         rep.reported = self.n_reported;
+        if cfg.birth.placement == BirthPlacement::RangePeak {
+            self.choose_birth_peak(map);
+        }
         self.frames = self.frames.saturating_add(1);
         Ok(rep)
+    }
+
+    /// [`BirthPlacement::RangePeak`]: the range of the largest `sum_{|k| <= w} S_(i+k)`,
+    /// `S_i` the row sums of `map`, `w = round(zeta_r / range_bin)` (at most 32 rows), over
+    /// the rows farther than `KAPPA zeta_r` from every reported component. Cost:
+    /// `(2 w + 1)` passes over the map.
+    fn choose_birth_peak(&mut self, map: &F) {
+        let g = self.cfg.geometry;
+        let zr = self.cfg.spread.zeta_r;
+        let w = math::round(zr / g.range_bin).clamp(0.0, 32.0) as usize;
+        let gate = KAPPA * zr;
+        let mut best: Option<(usize, f32)> = None;
+        for i in 0..g.n_range {
+            let rc = g.range_centre(i);
+            let taken = self
+                .reported
+                .get(..self.n_reported)
+                .unwrap_or(&[])
+                .iter()
+                .filter_map(|&k| self.comps.get(k as usize))
+                .any(|c| (c.est[idx::R] - rc).abs() <= gate);
+            if taken {
+                continue;
+            }
+            let mut t = 0.0f32;
+            for row in i.saturating_sub(w)..(i + w + 1).min(g.n_range) {
+                map.for_each(&self.dq, row * g.n_velocity, g.n_velocity, |_, v| t += v);
+            }
+            if t.is_finite() && best.is_none_or(|(_, b)| t > b) {
+                best = Some((i, t));
+            }
+        }
+        match best {
+            Some((i, _)) => {
+                self.birth_peak = g.range_centre(i);
+                self.has_peak = true;
+            }
+            None => self.has_peak = false,
+        }
     }
 }
 
@@ -898,6 +1003,7 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Detec
         self.n_reported = 0;
         self.next_id = 1;
         self.frames = 0;
+        self.has_peak = false;
         self.rng = Rng::seed_from_u64(seed);
     }
 
@@ -955,6 +1061,8 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
             frames: 0,
             reported: [0; C],
             n_reported: 0,
+            birth_peak: 0.0,
+            has_peak: false,
             _frame: PhantomData,
         };
         f.configure(&cfg, seed)?;

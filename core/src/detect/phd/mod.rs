@@ -22,5 +22,5 @@ pub use kmeans::KMeans;
 pub use pso::{PsoConfig, Swarm, MAX_GENERATIONS};
 pub use smc_phd::{
     BirthComponent, BirthMode, BirthModel, Estimate, Extractor, PhdConfig, PhdReport, SmcPhdTbd,
-    MAX_BIRTH_COMPONENTS, MAX_INTENSITY, MAX_MUTATION,
+    MAX_BIRTH_COMPONENTS, MAX_INTENSITY, MAX_MUTATION, MAX_REGION_CELLS,
 };

@@ -8,6 +8,8 @@ use super::*;
 pub const MAX_BIRTH_COMPONENTS: usize = 4;
 /// Maximum cells a measurement-driven birth component samples from.
 pub const MAX_BIRTH_CELLS: usize = 16;
+/// Maximum cells of [`BirthMode::Region`] (the components' cell stores, pooled).
+pub const MAX_REGION_CELLS: usize = MAX_BIRTH_CELLS * MAX_BIRTH_COMPONENTS;
 
 /// One birth component: Gaussian over `[x, vx, y, vy]` with independent axes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -50,6 +52,19 @@ pub enum BirthMode {
         /// `N(0, tangential_std^2)`.
         pair_max_speed: f32,
     },
+    /// Measurement-driven over the whole cube (no birth points; the components are not
+    /// used): the `cells` strongest local peaks of the previous frame's statistic
+    /// `sum h^2 z` over every cell, a peak being stronger than every kept cell within one
+    /// cell on each axis; a birth particle is uniform inside one of them (range, azimuth,
+    /// radial velocity) with a tangential velocity `N(0, tangential_std^2)`, propagated
+    /// one CV step. On the first frame (no previous frame) births are uniform over the
+    /// cube's range, azimuth and Doppler extent.
+    Region {
+        /// Peaks kept (1..=64).
+        cells: usize,
+        /// Standard deviation of the unobserved tangential velocity (m/s).
+        tangential_std: f32,
+    },
 }
 
 /// Birth density.
@@ -82,6 +97,10 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         if j == 0 {
             return;
         }
+        if let BirthMode::Region { tangential_std, .. } = b.mode {
+            self.add_region_births(j, tangential_std);
+            return;
+        }
         let wb = b.mass / j as f32;
         let nc = b.n_components;
         let mut k = self.n;
@@ -97,7 +116,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                     pair_max_speed,
                     ..
                 } => (tangential_std, pair_max_speed),
-                BirthMode::Gaussian => (0.0, 0.0),
+                BirthMode::Gaussian | BirthMode::Region { .. } => (0.0, 0.0),
             };
             let prev = self.birth_prev[ci];
             let np = if vmax > 0.0 {
@@ -160,6 +179,146 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         self.n = k;
     }
 
+    /// [`BirthMode::Region`] births: `j` particles, each uniform in one of the previous
+    /// frame's peaks (or over the whole cube before the first frame).
+    fn add_region_births(&mut self, j: usize, tang: f32) {
+        let b = self.cfg.birth;
+        let g = self.cfg.geometry;
+        let t = self.cfg.dt;
+        let wb = b.mass / j as f32;
+        let nb = self.region_nb;
+        let mut k = self.n;
+        for _ in 0..j {
+            let (ir, jd, lb) = if nb > 0 {
+                let pick = self.rng.below(nb as u32) as usize;
+                let idx = self.birth_cells.as_flattened().get(pick).map_or(0, |c| c.0);
+                g.unindex(idx)
+            } else {
+                (
+                    self.rng.below(g.n_range as u32) as usize,
+                    self.rng.below(g.n_doppler as u32) as usize,
+                    self.rng.below(g.n_azimuth as u32) as usize,
+                )
+            };
+            let r = g.range_start + (ir as f32 + self.rng.uniform()) * g.range_cell;
+            let d = g.doppler_start + (jd as f32 + self.rng.uniform()) * g.doppler_cell;
+            let az = (g.azimuth_start_deg + (lb as f32 + self.rng.uniform()) * g.azimuth_cell_deg)
+                / DEG_PER_RAD;
+            let (sb, cb) = (math::sin(az), math::cos(az));
+            let vt = tang * self.rng.normal();
+            let (vx, vy) = (d * cb - vt * sb, d * sb + vt * cb);
+            let inten = self.rng.uniform_range(b.intensity[0], b.intensity[1]);
+            // k < n + j <= N
+            if let (Some(x), Some(w)) = (self.x.get_mut(k), self.w.get_mut(k)) {
+                *x = [
+                    r * cb + t * vx,
+                    vx,
+                    r * sb + t * vy,
+                    vy,
+                    inten.max(self.cfg.min_intensity),
+                ];
+                *w = wb;
+                k += 1;
+            }
+        }
+        self.n = k;
+    }
+
+    /// [`BirthMode::Region`]: the `want` strongest local peaks of `sum h^2 z` (a target
+    /// at the cell centre) over the whole cube, into the pooled birth-cell store. A cell
+    /// within one cell on every axis of a kept one replaces it if stronger, else is
+    /// skipped, so that one target's spread does not fill the store.
+    pub(super) fn choose_region_cells(&mut self, cube: &PowerCube<'_>, want: usize) {
+        let g = self.cfg.geometry;
+        let psf = self.cfg.psf;
+        let w = psf.half_width.min(MAX_HALF_WIDTH);
+        let span = 2 * w + 1;
+        // Weights of a target at a cell centre, squared: `h^2 = exp(-L delta^2)`,
+        // `delta = k - w` cells (the interior cells of `PointSpread::axis_weights`).
+        let mut h2 = [[0.0f32; 2 * MAX_HALF_WIDTH + 1]; 3];
+        for (a, loss) in [psf.loss_range, psf.loss_doppler, psf.loss_azimuth]
+            .into_iter()
+            .enumerate()
+        {
+            for k in 0..span {
+                let dl = k as f32 - w as f32;
+                h2[a][k] = math::exp(-loss * dl * dl);
+            }
+        }
+        let data = cube.data();
+        let out = self.birth_cells.as_flattened_mut();
+        let want = want.min(out.len());
+        let mut n = 0usize;
+        // The weakest kept statistic once the store is full.
+        let mut min = f32::NEG_INFINITY;
+        let near = |a: usize, b: usize| a.abs_diff(b) <= 1;
+        for ir in 0..g.n_range {
+            for jd in 0..g.n_doppler {
+                for lb in 0..g.n_azimuth {
+                    let mut z = 0.0f32;
+                    for (a, &hr) in h2[0].iter().enumerate().take(span) {
+                        let Some(i) = (ir + a).checked_sub(w).filter(|&i| i < g.n_range) else {
+                            continue;
+                        };
+                        for (c, &hd) in h2[1].iter().enumerate().take(span) {
+                            let Some(j) = (jd + c).checked_sub(w).filter(|&j| j < g.n_doppler)
+                            else {
+                                continue;
+                            };
+                            let base = (i * g.n_doppler + j) * g.n_azimuth;
+                            for (e, &hb) in h2[2].iter().enumerate().take(span) {
+                                let Some(l) = (lb + e).checked_sub(w).filter(|&l| l < g.n_azimuth)
+                                else {
+                                    continue;
+                                };
+                                if let Some(&v) = data.get(base + l) {
+                                    z += hr * hd * hb * v;
+                                }
+                            }
+                        }
+                    }
+                    if n == want && z <= min {
+                        continue;
+                    }
+                    let idx = g.index(ir, jd, lb);
+                    // A kept neighbour: the stronger of the two stays.
+                    let kept = out.get_mut(..n).unwrap_or(&mut []);
+                    if let Some(c) = kept.iter_mut().find(|c| {
+                        let (pr, pd, pl) = g.unindex(c.0);
+                        near(pr, ir) && near(pd, jd) && near(pl, lb)
+                    }) {
+                        if z > c.1 {
+                            *c = (idx, z);
+                        }
+                        continue;
+                    }
+                    if n < want {
+                        if let Some(c) = out.get_mut(n) {
+                            *c = (idx, z);
+                            n += 1;
+                        }
+                    } else if let Some(c) = out
+                        .get_mut(..n)
+                        .unwrap_or(&mut [])
+                        .iter_mut()
+                        .min_by(|a, b| a.1.partial_cmp(&b.1).unwrap_or(core::cmp::Ordering::Equal))
+                    {
+                        *c = (idx, z);
+                    }
+                    if n == want {
+                        min = out
+                            .get(..n)
+                            .unwrap_or(&[])
+                            .iter()
+                            .map(|c| c.1)
+                            .fold(f32::INFINITY, f32::min);
+                    }
+                }
+            }
+        }
+        self.region_nb = n;
+    }
+
     /// Top cells by power inside the `3 sigma` position window of `comp`.
     /// Measurement-driven birth: picks each component's strongest cells on this frame
     /// for the births of the *next* frame. Births placed on a frame's strongest cells and
@@ -171,6 +330,10 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
     pub(super) fn choose_birth_cells(&mut self, cube: &PowerCube<'_>) {
         let b = self.cfg.birth;
         let g = self.cfg.geometry;
+        if let BirthMode::Region { cells, .. } = b.mode {
+            self.choose_region_cells(cube, cells);
+            return;
+        }
         self.birth_prev = self.birth_cells;
         self.birth_prev_nb = self.birth_nb;
         for ci in 0..b.n_components.min(MAX_BIRTH_COMPONENTS) {
@@ -182,7 +345,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                     &b.components[ci],
                     &mut self.birth_cells[ci][..want.min(MAX_BIRTH_CELLS)],
                 ),
-                BirthMode::Gaussian => 0,
+                BirthMode::Gaussian | BirthMode::Region { .. } => 0,
             };
         }
     }

@@ -25,7 +25,9 @@ mod birth;
 mod swarm;
 mod update;
 
-pub use birth::{BirthComponent, BirthMode, BirthModel, MAX_BIRTH_CELLS, MAX_BIRTH_COMPONENTS};
+pub use birth::{
+    BirthComponent, BirthMode, BirthModel, MAX_BIRTH_CELLS, MAX_BIRTH_COMPONENTS, MAX_REGION_CELLS,
+};
 
 use super::dbscan::{Dbscan, DbscanParams};
 use super::kmeans::KMeans;
@@ -33,7 +35,7 @@ use super::pso::{PsoConfig, Swarm};
 use crate::detect::{Detection, Detector, ScoreKind, Validate};
 use crate::math::{self, KahanSum};
 use crate::model::power_cube::{
-    AxisWeights, CubeGeometry, PointSpread, PowerCube, RadarCoords, DEG_PER_RAD,
+    AxisWeights, CubeGeometry, PointSpread, PowerCube, RadarCoords, DEG_PER_RAD, MAX_HALF_WIDTH,
 };
 use crate::particles::{resample, Scheme};
 use crate::rng::Rng;
@@ -135,7 +137,8 @@ impl Validate for PhdConfig {
             return Err(Error::InvalidConfig("clutter_lambda"));
         }
         let b = &self.birth;
-        if b.n_components == 0 || b.n_components > MAX_BIRTH_COMPONENTS {
+        let region = matches!(b.mode, BirthMode::Region { .. });
+        if (b.n_components == 0 && !region) || b.n_components > MAX_BIRTH_COMPONENTS {
             return Err(Error::InvalidConfig("birth.n_components"));
         }
         for c in &b.components[..b.n_components] {
@@ -155,6 +158,15 @@ impl Validate for PhdConfig {
                 || !nonneg(pair_max_speed)
             {
                 return Err(Error::InvalidConfig("birth measurement mode"));
+            }
+        }
+        if let BirthMode::Region {
+            cells,
+            tangential_std,
+        } = b.mode
+        {
+            if cells == 0 || cells > MAX_REGION_CELLS || !nonneg(tangential_std) {
+                return Err(Error::InvalidConfig("birth region mode (cells 1..=64)"));
             }
         }
         if b.particles == 0 || !pos(b.mass) {
@@ -271,6 +283,8 @@ pub struct SmcPhdTbd<const N: usize, const S: usize, const M: usize, const K: us
     /// The same, chosen the frame before (for two-frame birth velocities).
     birth_prev: [[(usize, f32); MAX_BIRTH_CELLS]; MAX_BIRTH_COMPONENTS],
     birth_prev_nb: [usize; MAX_BIRTH_COMPONENTS],
+    /// Peaks of [`BirthMode::Region`] in `birth_cells` (pooled).
+    region_nb: usize,
 }
 
 impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N, S, M, K> {
@@ -303,6 +317,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             birth_nb: [0; MAX_BIRTH_COMPONENTS],
             birth_prev: [[(0, 0.0); MAX_BIRTH_CELLS]; MAX_BIRTH_COMPONENTS],
             birth_prev_nb: [0; MAX_BIRTH_COMPONENTS],
+            region_nb: 0,
         })
     }
 
@@ -460,6 +475,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> Detector
         self.rng = Rng::seed_from_u64(seed);
         self.birth_nb = [0; MAX_BIRTH_COMPONENTS];
         self.birth_prev_nb = [0; MAX_BIRTH_COMPONENTS];
+        self.region_nb = 0;
     }
 
     fn step(&mut self, cube: &[f32]) -> Result<PhdReport> {
