@@ -207,6 +207,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 },
                 a.out.display()
             );
+            if let Some(got) = cal.achieved_pfa().filter(|&g| g < 0.5 * cal.pfa) {
+                println!(
+                    "{}: note: the {} score is discrete and ties at the thresholds: they achieve Pfa {got:.4} on the noise runs (mean over frames), below the {} asked",
+                    cal.detector, cal.score, cal.pfa
+                );
+            }
             Ok(())
         }
         Command::Evaluate(a) => {
@@ -378,7 +384,21 @@ fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// A closed pipe (`faint detect --list | head`) ends the process quietly, as it does for
+/// other Unix tools, instead of a panic in `println!`: the signal's default action is
+/// restored (Rust ignores SIGPIPE at start-up).
+#[cfg(unix)]
+fn default_sigpipe() {
+    // SAFETY: called first in `main`, before any thread starts; `signal` with `SIG_DFL`
+    // has no other precondition.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    #[cfg(unix)]
+    default_sigpipe();
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,

@@ -84,6 +84,14 @@ fn thresholds_hold_their_pfa_on_fresh_noise() {
         assert_eq!(cal.thresholds.len(), l);
         let back = Calibration::load(&dir.join(format!("{det}.json"))).unwrap();
         assert_eq!(back, cal);
+        // The order statistic of rank ceil(400 * 0.95) = 380: 20 runs above it, fewer
+        // only where scores tie at it (continuous scores: never, bar -inf frames).
+        for t in &cal.thresholds {
+            let e = t.exceedances.expect("exceedances written");
+            assert!(e <= 20, "{det} frame {}: {e} runs above", t.frame);
+        }
+        let got = cal.achieved_pfa().unwrap();
+        assert!(got <= 0.05 && got > 0.0, "{det}: achieved {got}");
         let rate = false_alarm_rate(&cal, &b, runs, l);
         eprintln!(
             "{det}: false-alarm rate on fresh noise {rate:.4} (Pfa 0.05, 400 x 16 frame-runs)"

@@ -58,3 +58,27 @@ fn known_scenarios_print_as_json() {
         assert!(json.trim_start().starts_with('{'), "{name}: {json}");
     }
 }
+
+/// Regression: `faint detect --list | head -1` panicked in `println!` ("failed printing to
+/// stdout: Broken pipe", exit 101). The reader closes its end before the child writes, so
+/// every write meets a closed pipe; the process must end quietly (by SIGPIPE, or 0).
+#[test]
+fn closed_stdout_ends_quietly() {
+    use std::process::{Command, Stdio};
+    for args in [
+        &["detect", "--list"][..],
+        &["detect", "crpf", "--print-config"][..],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_faint"))
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("spawn faint");
+        drop(child.stdout.take());
+        let out = child.wait_with_output().expect("wait for faint");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert_ne!(out.status.code(), Some(101), "{args:?}: {err}");
+    }
+}

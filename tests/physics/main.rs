@@ -125,3 +125,24 @@ fn bad_arguments_are_refused() {
         assert_one_line_error(code, &err, needle, &args);
     }
 }
+
+/// Every detector whose input kind has a physics simulator goes through the whole
+/// harness (calibrate, fresh noise, one SNR point) with its default configuration file.
+/// A smoke test: 60 runs of 4 frames are too few for a statistical claim (docs/detect.md
+/// holds the measured table); it checks that each default file is one the simulator
+/// and the calibration accept, the regression behind the DP file's new `noise` key.
+#[test]
+fn every_detector_with_a_simulator_runs_the_harness() {
+    faint::host::montecarlo::set_quiet(true);
+    for e in faint::host::detect::REGISTRY {
+        use faint::host::detect::InputKind;
+        if matches!(e.input, InputKind::PowerCubes | InputKind::PowerMaps) {
+            continue;
+        }
+        let ev = run(&args(e.name, 0.2, 60, 4, "20"))
+            .unwrap_or_else(|err| panic!("{}: {err:#}", e.name));
+        assert_eq!(ev.pfa_measured.n, 60, "{}", e.name);
+        assert_eq!(ev.curve.len(), 1, "{}", e.name);
+        eprintln!("{}", ev.row());
+    }
+}

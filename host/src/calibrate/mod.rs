@@ -197,6 +197,7 @@ pub fn run(a: &Args) -> Result<Calibration> {
             ci_low: finite(t.ci_low),
             ci_high: finite(t.ci_high),
             reported: col.iter().filter(|x| x.is_finite()).count(),
+            exceedances: Some(col.iter().filter(|&&x| x > t.value).count()),
         });
     }
     let cal = Calibration {

@@ -95,6 +95,12 @@ pub struct FrameThreshold {
     pub ci_high: Option<f32>,
     /// Noise runs that reported any detection at this frame (before thresholding).
     pub reported: usize,
+    /// Noise runs whose score exceeds `value` (strictly): the rate the threshold achieved
+    /// on its own noise is `exceedances / runs`. It is `floor(runs pfa)` for a continuous
+    /// score; a discrete score (a count, a merit on a grid) ties at the threshold and
+    /// achieves less, which this field states (absent in files of older builds).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exceedances: Option<usize>,
 }
 
 /// A calibration: thresholds of one detector and configuration at a false-alarm
@@ -130,6 +136,16 @@ pub struct Calibration {
 }
 
 impl Calibration {
+    /// The false-alarm rate the thresholds achieved on their own noise runs, averaged
+    /// over the frame indices (`exceedances / runs`); `None` for files of older builds.
+    /// Below `pfa` for a discrete score, whose values tie at the threshold.
+    pub fn achieved_pfa(&self) -> Option<f64> {
+        let counts: Option<Vec<usize>> = self.thresholds.iter().map(|t| t.exceedances).collect();
+        let counts = counts.filter(|c| !c.is_empty() && self.runs > 0)?;
+        let total: usize = counts.iter().sum();
+        Some(total as f64 / (counts.len() as f64 * self.runs as f64))
+    }
+
     /// Reads and checks `path`.
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)

@@ -7,9 +7,11 @@
 //! 2. False alarms: `runs` fresh noise-only runs through `faint detect`'s machinery
 //!    ([`Request::restart_every`] `= L`); a run is a false alarm when its final frame
 //!    `L - 1` declares a detection (a score above the threshold). The rate has a
-//!    Clopper-Pearson 95 % interval. The calibration's own interval is that of the true
-//!    exceedance probability of its threshold, the order statistic of rank
-//!    `r = ceil(n (1 - pfa))` of `n` runs: `Beta(n - r + 1, r)`, 2.5 % to 97.5 %.
+//!    Clopper-Pearson 95 % interval. The calibration predicts that count: its threshold's
+//!    true exceedance probability is `Beta(e + 1, n - e)` when `e` of its `n` runs exceed
+//!    it (`e = n - ceil(n (1 - pfa))` for a continuous score, fewer for a discrete one that
+//!    ties at the threshold), so the count is beta-binomial; the measurement is
+//!    consistent when it falls in that law's central 95 % ([`calibration_prediction`]).
 //! 3. Detection: for each SNR, `runs` runs with one target born anywhere in the region;
 //!    Pd is the share whose final frame declares a detection and, where the detector
 //!    reports positions, one within the kind's gate of the truth ([`Physics::gate`]).
@@ -34,6 +36,60 @@ use crate::calibrate;
 use crate::detect::calibration::Calibration;
 use crate::detect::{self, Entry, Request};
 use crate::stats::detection::{proportion, snr_at_pd, PdPoint, Proportion};
+
+/// What a calibration predicts for the false alarms of fresh noise runs at frame `k`.
+///
+/// `e` of the calibration's `n` runs exceed frame `k`'s threshold (`e = n - r` for a
+/// continuous score, the threshold being the order statistic of rank
+/// `r = ceil(n (1 - pfa))`; fewer for a discrete score that ties at it). The threshold's
+/// true exceedance probability is then `p ~ Beta(e + 1, n - e)` (exactly so for the order
+/// statistic of a continuous score), and the count of `m` fresh runs that exceed it is
+/// beta-binomial `BB(m, e + 1, n - e)`. Returns the 95 % interval of `p` and the central
+/// 95 % interval `[k_lo, k_hi]` of that count.
+pub fn calibration_prediction(
+    cal: &Calibration,
+    k: usize,
+    pfa: f64,
+    m: usize,
+) -> Result<((f64, f64), (usize, usize))> {
+    let n = cal.runs;
+    let r = ((n as f64) * (1.0 - pfa)).ceil() as usize;
+    let e = cal
+        .thresholds
+        .iter()
+        .find(|t| t.frame == k)
+        .and_then(|t| t.exceedances)
+        .unwrap_or(n.saturating_sub(r))
+        .min(n.saturating_sub(1));
+    let (a, b) = ((e + 1) as f64, (n - e) as f64);
+    let beta = Beta::new(a, b)?;
+    let p = (beta.inverse_cdf(0.025), beta.inverse_cdf(0.975));
+    Ok((p, beta_binomial_interval(m, a, b)))
+}
+
+/// The central 95 % interval of a beta-binomial `BB(m, a, b)` count:
+/// `P(k) = C(m, k) B(k + a, m - k + b) / B(a, b)`, summed in the log domain.
+fn beta_binomial_interval(m: usize, a: f64, b: f64) -> (usize, usize) {
+    use statrs::function::gamma::ln_gamma;
+    let ln_beta = |x: f64, y: f64| ln_gamma(x) + ln_gamma(y) - ln_gamma(x + y);
+    let mf = m as f64;
+    let (mut cdf, mut lo, mut hi) = (0.0, None, m);
+    for k in 0..=m {
+        let kf = k as f64;
+        let ln_p = ln_gamma(mf + 1.0) - ln_gamma(kf + 1.0) - ln_gamma(mf - kf + 1.0)
+            + ln_beta(kf + a, mf - kf + b)
+            - ln_beta(a, b);
+        cdf += ln_p.exp();
+        if lo.is_none() && cdf >= 0.025 {
+            lo = Some(k);
+        }
+        if cdf >= 0.975 {
+            hi = k;
+            break;
+        }
+    }
+    (lo.unwrap_or(0), hi)
+}
 
 /// Runs per file (and per parallel task).
 pub const GROUP: usize = 25;
@@ -115,6 +171,9 @@ pub struct Evaluation {
     pub pfa_measured: Proportion,
     /// The calibration's 95 % interval of its threshold's exceedance probability.
     pub calibration_interval: (f64, f64),
+    /// The central 95 % of the false-alarm count the calibration predicts for `runs`
+    /// fresh noise runs.
+    pub predicted_false_alarms: (usize, usize),
     /// Runs per set.
     pub runs: usize,
     /// Frames per run.
@@ -132,15 +191,16 @@ pub struct Evaluation {
 }
 
 impl Evaluation {
-    /// True if the measured rate lies in the calibration's interval.
+    /// True if the fresh runs' false-alarm count lies in the central 95 % of the count
+    /// the calibration predicts.
     pub fn consistent(&self) -> bool {
-        let (lo, hi) = self.calibration_interval;
-        self.pfa_measured.p >= lo && self.pfa_measured.p <= hi
+        let (lo, hi) = self.predicted_false_alarms;
+        (lo..=hi).contains(&self.pfa_measured.k)
     }
 
     /// The Markdown table's header.
     pub fn header() -> &'static str {
-        "| detector | input | SNR at Pd 0.9 (dB) | Pfa nominal | Pfa measured [95 %] | in the calibration's interval | runs | set by the user |\n|---|---|---|---|---|---|---|---|"
+        "| detector | input | SNR at Pd 0.9 (dB) | Pfa nominal | Pfa measured [95 %] | as the calibration predicts [95 %] | runs | set by the user |\n|---|---|---|---|---|---|---|---|"
     }
 
     /// One Markdown row.
@@ -153,7 +213,9 @@ impl Evaluation {
             }
             None => format!("not reached up to {top:.1}"),
         };
-        let (lo, hi) = self.calibration_interval;
+        let (k_lo, k_hi) = self.predicted_false_alarms;
+        let m = self.pfa_measured.n.max(1) as f64;
+        let (lo, hi) = (k_lo as f64 / m, k_hi as f64 / m);
         format!(
             "| {} | {} | {snr} | {} | {:.4} [{:.4}, {:.4}] | {} ([{lo:.4}, {hi:.4}]) | {} x {} frames | {} |",
             self.detector,
@@ -300,10 +362,7 @@ pub fn run(a: &Args) -> Result<Evaluation> {
         seed: derive_seed(a.seed, 10),
         out: cal_path,
     })?;
-    let n = cal.runs as f64;
-    let r = (n * (1.0 - a.pfa)).ceil();
-    let beta = Beta::new(n - r + 1.0, r.max(1.0))?;
-    let interval = (beta.inverse_cdf(0.025), beta.inverse_cdf(0.975));
+    let (interval, predicted) = calibration_prediction(&cal, l - 1, a.pfa, a.runs)?;
 
     // 2. False alarms on fresh noise.
     let set = |s: u64, snr: Option<f64>| -> Result<Vec<(bool, bool)>> {
@@ -350,6 +409,7 @@ pub fn run(a: &Args) -> Result<Evaluation> {
         pfa: a.pfa,
         pfa_measured,
         calibration_interval: interval,
+        predicted_false_alarms: predicted,
         runs: a.runs,
         frames: l,
         gate: probe.then(|| phys.gate()),
@@ -478,4 +538,31 @@ fn measure(
         all.extend(g?);
     }
     Ok(all)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::beta_binomial_interval;
+    use statrs::distribution::{Binomial, DiscreteCDF};
+
+    /// `BB(m, 1, 1)` is uniform on `0..=m`: with `m = 99` each count has 0.01, so the
+    /// 2.5 % point is 2 (cdf 0.03) and the 97.5 % point 97 (cdf 0.98).
+    #[test]
+    fn beta_binomial_with_a_flat_prior_is_uniform() {
+        assert_eq!(beta_binomial_interval(99, 1.0, 1.0), (2, 97));
+    }
+
+    /// With `a + b` large and `a / (a + b) = p` the law tends to Binomial(m, p): with
+    /// `a + b = 10^6` the extra variance is `m / (a + b)` of the binomial's, so the
+    /// quantiles agree with the binomial's.
+    #[test]
+    fn beta_binomial_tends_to_the_binomial() {
+        let (m, p) = (400u64, 0.05);
+        let bin = Binomial::new(p, m).unwrap();
+        let want = (
+            bin.inverse_cdf(0.025) as usize,
+            bin.inverse_cdf(0.975) as usize,
+        );
+        assert_eq!(beta_binomial_interval(400, p * 1e6, (1.0 - p) * 1e6), want);
+    }
 }
