@@ -12,7 +12,8 @@
 //!
 //! It runs each document's commands in document order, in a scratch folder of its own
 //! (with `firmware`, `fuzz` and `target` linked in), through the shims of [`shims`]:
-//! `faint reproduce` in its smoke form (`--quick` in place of the run counts), soak and
+//! `faint reproduce` in its smoke form (`--quick` in place of the run counts), `faint
+//! evaluate` in its (`shims::EVALUATE_SMOKE` in place of its size options), soak and
 //! fuzz counts capped, benches once each. A command that `.ci/run` itself runs (the
 //! test, lint and firmware steps) is not run twice. A command that fails fails the test,
 //! with its output. `FAINT_DOC_ONLY=docs/crpf.md` runs one document's commands;

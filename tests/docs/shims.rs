@@ -23,6 +23,12 @@ pub const RUN_COUNTS: &[&str] = &[
     "--sweep-trials",
 ];
 
+/// Options of `faint evaluate` that set its size: CI drops them and adds
+/// [`EVALUATE_SMOKE`] (the harness end to end, too few runs for a claim).
+pub const EVALUATE_COUNTS: &[&str] = &["--pfa", "--runs", "--snr-db", "--frames"];
+/// The smoke form of `faint evaluate`.
+pub const EVALUATE_SMOKE: &str = "--pfa 0.2 --runs 50 --snr-db 20 --frames 4";
+
 /// `faint soak --frames` and the firmware soak's `frames=` are capped at this many
 /// frames per detector; `faint fuzz --cases` at [`FUZZ_CASES`].
 pub const SOAK_FRAMES: u64 = 200;
@@ -35,8 +41,9 @@ pub const REFUSED: i32 = 97;
 
 const FAINT: &str = r#"#!/usr/bin/env bash
 # `faint` as CI runs the documented commands: the binary in FAINT_DOC_BIN (release) with
-# reproductions in their smoke form (run counts, SNR grids and Pfa dropped, --quick added) and soak/fuzz
-# counts capped.
+# reproductions in their smoke form (run counts, SNR grids and Pfa dropped, --quick added),
+# evaluations in theirs (size options replaced by a small fixed set) and soak/fuzz counts
+# capped.
 set -euo pipefail
 sub=""
 for a in "$@"; do case "$a" in -*) ;; *) sub="$a"; break ;; esac; done
@@ -54,6 +61,8 @@ for a in "$@"; do
         reproduce:--quick) quick=1 ;;
         @RUN_COUNTS@) drop=1; continue ;;
         @RUN_COUNTS_EQ@) continue ;;
+        @EVALUATE_COUNTS@) drop=1; continue ;;
+        @EVALUATE_COUNTS_EQ@) continue ;;
         soak:--frames) cap_next=@SOAK@ ;;
         soak:--frames=*) n="${a#--frames=}"; if [ "$n" -gt @SOAK@ ] 2>/dev/null; then a="--frames=@SOAK@"; fi ;;
         fuzz:--cases) cap_next=@FUZZ@ ;;
@@ -63,7 +72,8 @@ for a in "$@"; do
 done
 if [ "$sub" = reproduce ] && [ "$quick" = 0 ]; then out+=("--quick"); fi
 case " $* " in *" --help "*|*" -h "*) ;;
-    *) if [ "$sub" = soak ] && [[ " $* " != *" --frames"* ]]; then out+=(--frames @SOAK@); fi
+    *) if [ "$sub" = evaluate ]; then out+=(@EVALUATE_SMOKE@); fi
+       if [ "$sub" = soak ] && [[ " $* " != *" --frames"* ]]; then out+=(--frames @SOAK@); fi
        if [ "$sub" = fuzz ] && [[ " $* " != *" --cases"* ]]; then out+=(--cases @FUZZ@); fi ;;
 esac
 exec "$FAINT_DOC_BIN" "${out[@]}"
@@ -156,8 +166,19 @@ pub fn install(dir: &Path) -> std::io::Result<PathBuf> {
         .iter()
         .map(|o| format!("reproduce:{o}=*"))
         .collect();
+    let ev: Vec<String> = EVALUATE_COUNTS
+        .iter()
+        .map(|o| format!("evaluate:{o}"))
+        .collect();
+    let ev_eq: Vec<String> = EVALUATE_COUNTS
+        .iter()
+        .map(|o| format!("evaluate:{o}=*"))
+        .collect();
     let fill = |s: &str| {
         s.replace("@RUN_COUNTS@", &plain.join("|"))
+            .replace("@EVALUATE_COUNTS@", &ev.join("|"))
+            .replace("@EVALUATE_COUNTS_EQ@", &ev_eq.join("|"))
+            .replace("@EVALUATE_SMOKE@", EVALUATE_SMOKE)
             .replace("@RUN_COUNTS_EQ@", &eq.join("|"))
             .replace("@SOAK@", &SOAK_FRAMES.to_string())
             .replace("@FUZZ@", &FUZZ_CASES.to_string())

@@ -104,7 +104,7 @@ fn field<T: serde::de::DeserializeOwned>(config: &serde_json::Value, path: &[&st
 impl Physics {
     /// The simulator matching a detector's input kind, with the geometry its
     /// configuration file reads (Doppler: `model.bins`, `model.ts`, `model.window`;
-    /// plots: `area`; images: 128 x 128, `noise.as_is.sigma` as the noise std where the
+    /// plots: `area`; images: 128 x 128, `noise.as-is.sigma` as the noise std where the
     /// file states it, else background 1000 and std 20).
     pub fn for_detector(kind: InputKind, config: &serde_json::Value) -> Result<Self> {
         let p = match kind {
@@ -116,18 +116,18 @@ impl Physics {
             }
             InputKind::Plots => Physics::Plots(PlotPhysics::new(field(config, &["area"])?)),
             InputKind::Images => {
-                // A file that states its noise (`noise.as_is`) gets images at that
+                // A file that states its noise (`noise.as-is`) gets images at that
                 // scale; a robust (scale-free) file gets a camera-like scale (background
                 // 1000, noise std 20) that no preset assumes.
-                let as_is = config.get("noise").and_then(|n| n.get("as_is"));
+                let as_is = config.get("noise").and_then(|n| n.get("as-is"));
                 let (sigma, background) = match as_is {
                     Some(a) => {
                         let sigma: f64 = serde_json::from_value(
                             a.get("sigma")
                                 .cloned()
-                                .ok_or_else(|| anyhow!("noise.as_is has no sigma"))?,
+                                .ok_or_else(|| anyhow!("noise.as-is has no sigma"))?,
                         )
-                        .map_err(|e| anyhow!("noise.as_is.sigma: {e}"))?;
+                        .map_err(|e| anyhow!("noise.as-is.sigma: {e}"))?;
                         (sigma, 0.0)
                     }
                     None => (20.0, 1000.0),
