@@ -13,6 +13,10 @@
 //! gate (eq. 10):    r = |<m_k, m_k^i>| / (||m_k|| ||m_k^i||),  m_k = [z_k, z_{k-1}],
 //!                   m_k^i = [h_k(x_k^i), h_{k-1}(x_{k-1}^parent)];  r < r_th => E = 0, x = 0
 //! existence (eq. 12): P_E^k = (1/N) sum_i E_k^i
+//! phase unknown (ModelConfig::phase):
+//!   cost:  ||z - h||^2 -> ||z||^2 - 2 |<z,h>| + ||h||^2   (minimised over the phase)
+//!   gate:  r = (|<z_k,h_k>| + |<z_{k-1},h_{k-1}>|) / (||m_k|| ||m_k^i||)
+//!          (maximised over the two frames' phases)
 //! estimates (eq. 8): mean-cost sum_i x_i mu(C_i), min-cost x_argmin C  (over E = 1)
 //! ```
 //!
@@ -65,7 +69,7 @@ use crate::detect::{Detection, Detector, ScoreKind, Validate};
 use crate::existence::{BirthGaps, ExistenceDraw};
 use crate::math::{self, KahanSum};
 use crate::model::doppler::{
-    check_frame, finite_estimate, DopplerModel, DopplerReport, Model, ModelConfig, Motion,
+    check_frame, finite_estimate, DopplerModel, DopplerReport, Model, ModelConfig, Motion, Phase,
     ProjectionCache, DOPPLER_STATE, MAX_BINS,
 };
 use crate::particles::{gather_flagged, resample, systematic_with_sum, FlaggedState, Scheme};
@@ -439,20 +443,35 @@ impl UpdateCtx<'_> {
             self.model.obs.project(self.z, x[0], x[2])
         };
         // Gate (eq. 10). r >= r_th  <=>  |<m, m^i>|^2 >= r_th^2 ||m||^2 ||m^i||^2 (no sqrt).
+        // Unknown phase: |<m, m^i>| maximised over the two frames' phases,
+        // |<z_k, h_k>| + |<z_{k-1}, h_{k-1}>|.
         let r_th = self.cfg.r_th;
-        let num2 = (pr.zh + par_zh).norm_sqr();
+        let phase = self.model.phase;
+        let num2 = match phase {
+            Phase::Zero => (pr.zh + par_zh).norm_sqr(),
+            Phase::Unknown => {
+                let n = math::hypot(pr.zh.re, pr.zh.im) + math::hypot(par_zh.re, par_zh.im);
+                n * n
+            }
+        };
         let den2 = self.norm_m2 * (pr.hh + par_hh);
         let pass = if den2.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
             r_th <= 0.0 // r = 0
         } else if num2.is_finite() && den2.is_finite() {
             num2 >= self.r_th2 * den2
         } else {
-            (pr.zh + par_zh).norm() / math::sqrt(den2) >= r_th
+            let num = match phase {
+                Phase::Zero => (pr.zh + par_zh).norm(),
+                Phase::Unknown => {
+                    math::hypot(pr.zh.re, pr.zh.im) + math::hypot(par_zh.re, par_zh.im)
+                }
+            };
+            num / math::sqrt(den2) >= r_th
         };
         if !pass {
             return (rng, None);
         }
-        let d2 = pr.residual_norm2(self.zz);
+        let d2 = pr.cost(self.zz, phase);
         let log_c = if self.ln_free {
             d2
         } else {
@@ -488,12 +507,14 @@ fn risk_present(
     };
     // BirthGaps land anywhere in the band: projected directly (a cache entry would be used
     // once).
-    let pr = if existed {
-        model.obs.project_cached::<false>(cache, z, xp[0], xp[2])
-    } else {
-        model.obs.project_re(z, xp[0], xp[2])
+    // Unknown phase: the cost needs |<z, h>|, the full projection.
+    let pr = match (existed, model.phase) {
+        (true, Phase::Zero) => model.obs.project_cached::<false>(cache, z, xp[0], xp[2]),
+        (true, Phase::Unknown) => model.obs.project_cached::<true>(cache, z, xp[0], xp[2]),
+        (false, Phase::Zero) => model.obs.project_re(z, xp[0], xp[2]),
+        (false, Phase::Unknown) => model.obs.project(z, xp[0], xp[2]),
     };
-    let d2 = pr.residual_norm2(zz);
+    let d2 = pr.cost(zz, model.phase);
     (rng, d2)
 }
 

@@ -5,6 +5,7 @@
 //! reset:     x_i ~ draw(prior)                             (per detector: E_0, U(I_x0))
 //! predict:   x_i <- move(x_i)   (per detector: F x + G v of eq. 16, births from U(I_x0))
 //! weigh:     ln w_i = (2 Re<z,h(x_i)> - ||h(x_i)||^2) / s2   if x_i holds a target,
+//!                   (phase unknown: ln I0(2 |<z,h(x_i)>| / s2) - ||h(x_i)||^2 / s2)
 //!            ln w_i = 0                                       otherwise
 //! normalise: w_i = exp(ln w_i - LSE),  LSE = ln sum_i exp(ln w_i)   (log domain)
 //! estimate:  sum_i w_i x_i / sum_i w_i over the particles holding a target (band wrap)
@@ -14,7 +15,9 @@
 
 use crate::detect::Validate;
 use crate::math;
-use crate::model::doppler::{check_frame, DopplerModel, DopplerReport, Model, ModelConfig, Motion};
+use crate::model::doppler::{
+    check_frame, DopplerModel, DopplerReport, Model, ModelConfig, Motion, Phase,
+};
 use crate::particles::{gather_in_place, resample, Scheme};
 use crate::rng::Rng;
 use crate::{Complex32, Error, Result};
@@ -157,6 +160,17 @@ pub(crate) fn log_mass(x: f32) -> f32 {
         math::ln(x)
     } else {
         f32::NEG_INFINITY
+    }
+}
+
+/// A target's log likelihood ratio against the frame under the model's phase:
+/// `(2 Re<z,h> - ||h||^2) / s2` (zero phase; `Re <z,h>` only) or the Rician
+/// `ln I0(2 |<z,h>| / s2) - ||h||^2 / s2` (unknown phase; the full projection).
+#[inline(always)]
+fn log_lr_of(m: &Model, z: &[Complex32], x: [f32; 3], inv_var: f32) -> f32 {
+    match m.phase {
+        Phase::Zero => m.obs.project_re(z, x[0], x[2]).log_lr(inv_var),
+        Phase::Unknown => m.obs.project(z, x[0], x[2]).log_lr_unknown_phase(inv_var),
     }
 }
 
@@ -311,7 +325,7 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
         for (p, lw) in self.parts.iter_mut().zip(self.log_w.iter_mut()) {
             step(p, m, &mut self.rng);
             *lw = match p.target() {
-                Some(x) => m.obs.project_re(z, x[0], x[2]).log_lr(self.inv_var),
+                Some(x) => log_lr_of(m, z, x, self.inv_var),
                 None => 0.0,
             };
         }
@@ -347,7 +361,7 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
             }
             let prior = step(p, birth_slot, m, &mut self.rng);
             *lw = match p.target() {
-                Some(x) => prior + m.obs.project_re(z, x[0], x[2]).log_lr(self.inv_var),
+                Some(x) => prior + log_lr_of(m, z, x, self.inv_var),
                 None => prior,
             };
         }
