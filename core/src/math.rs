@@ -247,7 +247,7 @@ const I0_ASYMPTOTIC: [f32; 9] = [
     -0.001_575_65,
     0.002_253_19,
     0.013_285_92,
-    0.398_942_28,
+    0.398_942_3,
 ];
 
 /// `ln I0(x)`, the logarithm of the modified Bessel function of the first kind of order

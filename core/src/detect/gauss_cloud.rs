@@ -166,11 +166,13 @@ pub(crate) fn log_mass(x: f32) -> f32 {
 /// A target's log likelihood ratio against the frame under the model's phase:
 /// `(2 Re<z,h> - ||h||^2) / s2` (zero phase; `Re <z,h>` only) or the Rician
 /// `ln I0(2 |<z,h>| / s2) - ||h||^2 / s2` (unknown phase; the full projection).
+/// `U`: the phase is unknown ([`Phase::Unknown`]; a constant of the frame's loop).
 #[inline(always)]
-fn log_lr_of(m: &Model, z: &[Complex32], x: [f32; 3], inv_var: f32) -> f32 {
-    match m.phase {
-        Phase::Zero => m.obs.project_re(z, x[0], x[2]).log_lr(inv_var),
-        Phase::Unknown => m.obs.project(z, x[0], x[2]).log_lr_unknown_phase(inv_var),
+fn log_lr_of<const U: bool>(m: &Model, z: &[Complex32], x: [f32; 3], inv_var: f32) -> f32 {
+    if U {
+        m.obs.project(z, x[0], x[2]).log_lr_unknown_phase(inv_var)
+    } else {
+        m.obs.project_re(z, x[0], x[2]).log_lr(inv_var)
     }
 }
 
@@ -321,15 +323,30 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
         mut step: impl FnMut(&mut P, &Model, &mut Rng),
     ) -> Result<()> {
         check_frame(z, self.model.obs.bins())?;
+        // The phase model as a constant of the loop (one copy per model).
+        match self.model.phase {
+            Phase::Zero => self.weigh_all::<false>(z, &mut step),
+            Phase::Unknown => self.weigh_all::<true>(z, &mut step),
+        }
+        Ok(())
+    }
+
+    /// The loop of [`predict_and_weigh`](Self::predict_and_weigh) for the phase model `U`
+    /// (its own function: the detectors' step stays the size it was).
+    #[inline(never)]
+    fn weigh_all<const U: bool>(
+        &mut self,
+        z: &[Complex32],
+        step: &mut impl FnMut(&mut P, &Model, &mut Rng),
+    ) {
         let m = &self.model;
         for (p, lw) in self.parts.iter_mut().zip(self.log_w.iter_mut()) {
             step(p, m, &mut self.rng);
             *lw = match p.target() {
-                Some(x) => log_lr_of(m, z, x, self.inv_var),
+                Some(x) => log_lr_of::<U>(m, z, x, self.inv_var),
                 None => 0.0,
             };
         }
-        Ok(())
     }
 
     /// [`predict_and_weigh`](Self::predict_and_weigh) for a fixed-share birth proposal:
@@ -348,6 +365,22 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
         mut step: impl FnMut(&mut P, bool, &Model, &mut Rng) -> f32,
     ) -> Result<()> {
         check_frame(z, self.model.obs.bins())?;
+        match self.model.phase {
+            Phase::Zero => self.weigh_split::<false>(z, births, &mut step),
+            Phase::Unknown => self.weigh_split::<true>(z, births, &mut step),
+        }
+        Ok(())
+    }
+
+    /// The loop of [`predict_and_weigh_split`](Self::predict_and_weigh_split) for the
+    /// phase model `U` (its own function, as `weigh_all`).
+    #[inline(never)]
+    fn weigh_split<const U: bool>(
+        &mut self,
+        z: &[Complex32],
+        births: u32,
+        step: &mut impl FnMut(&mut P, bool, &Model, &mut Rng) -> f32,
+    ) {
         let m = &self.model;
         // 2 <= N <= 2^31 and births < N (birth_count): acc + births < 2^32, and acc stays
         // below N after each step.
@@ -361,11 +394,10 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
             }
             let prior = step(p, birth_slot, m, &mut self.rng);
             *lw = match p.target() {
-                Some(x) => prior + log_lr_of(m, z, x, self.inv_var),
+                Some(x) => prior + log_lr_of::<U>(m, z, x, self.inv_var),
                 None => prior,
             };
         }
-        Ok(())
     }
 
     /// Particles without a target.
