@@ -10,6 +10,8 @@
 //!
 //! CRPF-TBD also gets three rows over 32 detector seeds (frames 1, 6 and 8, see
 //! `crpf_rows`), because its cost depends on the random fraction of present particles.
+//! At N = 1000, CRPF-TBD and PF-TBD get one more single-frame row each with
+//! `phase: unknown` (the phase-insensitive observation).
 
 use core::hint::black_box;
 use core::mem::{size_of, MaybeUninit};
@@ -19,7 +21,7 @@ use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint_core::detect::Detector;
-use faint_core::model::doppler::{DopplerModel, DopplerReport, Window};
+use faint_core::model::doppler::{DopplerModel, DopplerReport, Phase, Window};
 use faint_core::rng::Rng;
 use faint_core::Complex32;
 use faint_golden::crpf::{frame, target, BIN_VAR};
@@ -150,6 +152,20 @@ fn rows<const N: usize>(
         size_of::<CrpfTbd<N>>(),
     );
     crpf_rows(crpf, model);
+    // The unknown-phase observation (`faint detect`'s default) at N = 1000: the cost
+    // `||z||^2 - 2 |<z,h>| + ||h||^2` needs the full projection and a hypot per particle.
+    if N == 1000 {
+        let mut unknown = CrpfConfig::othr();
+        unknown.model.phase = Phase::Unknown;
+        check(crpf.configure(&unknown, SEED));
+        measure_one(
+            "CRPF-TBD step, phase unknown (32 bins)",
+            n,
+            &mut |z| crpf.step(z),
+            model,
+            size_of::<CrpfTbd<N>>(),
+        );
+    }
     check(pf.configure(&g, SEED));
     measure_one(
         "PF-TBD step (32 bins)",
@@ -158,6 +174,19 @@ fn rows<const N: usize>(
         model,
         size_of::<PfTbd<N>>(),
     );
+    // The Rician log-LR `ln I0(2 |<z,h>| / s2) - ||h||^2 / s2` at N = 1000.
+    if N == 1000 {
+        let mut unknown = g;
+        unknown.model.phase = Phase::Unknown;
+        check(pf.configure(&unknown, SEED));
+        measure_one(
+            "PF-TBD step, phase unknown (32 bins)",
+            n,
+            &mut |z| pf.step(z),
+            model,
+            size_of::<PfTbd<N>>(),
+        );
+    }
     check(jott.configure(&g, SEED));
     measure_one(
         "JOTT step (32 bins)",

@@ -570,3 +570,40 @@ fn cbmember_detectors_round_trip() {
     assert!(truth.starts_with("frame,range_m,velocity_m_per_s"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `faint detect`'s default Doppler configurations assume an unknown phase per frame;
+/// a file without the `phase` key (written before the option existed) still loads, as
+/// the zero phase it was run with, and so do the reproductions' presets.
+#[test]
+fn doppler_phase_defaults_and_files_without_the_key() {
+    use faint::core::model::doppler::Phase;
+    use faint::host::detect::{find, DopplerFile};
+    assert_eq!(CrpfConfig::othr().model.phase, Phase::Zero);
+    assert_eq!(GaussConfig::othr(1.0).model.phase, Phase::Zero);
+    assert_eq!(Othr::default().model().phase, Phase::Zero);
+    for name in ["crpf", "pf-tbd", "jott", "pf-lrt"] {
+        let text = (find(name).unwrap().default_config)();
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(v["config"]["model"]["phase"], "unknown", "{name}");
+        let model = v["config"]["model"].as_object_mut().unwrap();
+        model.remove("phase");
+        let old = v.to_string();
+        let phase = if name == "crpf" {
+            serde_json::from_str::<DopplerFile<CrpfConfig>>(&old)
+                .unwrap()
+                .config
+                .model
+                .phase
+        } else {
+            serde_json::from_str::<DopplerFile<GaussConfig>>(&old)
+                .unwrap()
+                .config
+                .model
+                .phase
+        };
+        assert_eq!(phase, Phase::Zero, "{name}");
+    }
+    let mut v = serde_json::to_value(CrpfConfig::othr()).unwrap();
+    v["model"]["phase"] = "sideways".into();
+    assert!(serde_json::from_value::<CrpfConfig>(v).is_err());
+}

@@ -18,7 +18,9 @@
 //! w_i ∝ v_i LR_i, estimate sum w_i x_i, resample N.
 //! ```
 //! Noise assumed complex Gaussian, independent bins, variance `s2` (see
-//! [`GaussConfig`](super::pf_tbd::GaussConfig)).
+//! [`GaussConfig`](super::pf_tbd::GaussConfig)). With
+//! [`Phase::Unknown`](crate::model::doppler::Phase) `LR_i` is averaged over a uniform
+//! phase per frame: `ln LR_i = ln I0(2 |<z,h_i>| / s2) - ||h_i||^2 / s2` (Rician).
 
 use super::gauss_cloud::{gauss_detector, log_mass, GaussianCloud};
 use crate::math;

@@ -13,6 +13,10 @@
 //! gate (eq. 10):    r = |<m_k, m_k^i>| / (||m_k|| ||m_k^i||),  m_k = [z_k, z_{k-1}],
 //!                   m_k^i = [h_k(x_k^i), h_{k-1}(x_{k-1}^parent)];  r < r_th => E = 0, x = 0
 //! existence (eq. 12): P_E^k = (1/N) sum_i E_k^i
+//! phase unknown (ModelConfig::phase):
+//!   cost:  ||z - h||^2 -> ||z||^2 - 2 |<z,h>| + ||h||^2   (minimised over the phase)
+//!   gate:  r = (|<z_k,h_k>| + |<z_{k-1},h_{k-1}>|) / (||m_k|| ||m_k^i||)
+//!          (maximised over the two frames' phases)
 //! estimates (eq. 8): mean-cost sum_i x_i mu(C_i), min-cost x_argmin C  (over E = 1)
 //! ```
 //!
@@ -65,7 +69,7 @@ use crate::detect::{Detection, Detector, ScoreKind, Validate};
 use crate::existence::{BirthGaps, ExistenceDraw};
 use crate::math::{self, KahanSum};
 use crate::model::doppler::{
-    check_frame, finite_estimate, DopplerModel, DopplerReport, Model, ModelConfig, Motion,
+    check_frame, finite_estimate, DopplerModel, DopplerReport, Model, ModelConfig, Motion, Phase,
     ProjectionCache, DOPPLER_STATE, MAX_BINS,
 };
 use crate::particles::{gather_flagged, resample, systematic_with_sum, FlaggedState, Scheme};
@@ -308,9 +312,10 @@ struct UpdateCtx<'a> {
 /// Step (4) over all particles, from birth gap `left`. Flags and states zipped: no index
 /// bounds check. As in `risk_pass`, the loop handles only an absent particle that stays
 /// absent; the rest is out of line. `KEEP` (`lambda > 0`, a constant so that the loop
-/// tests no flag): absent particles get their state written.
+/// tests no flag): absent particles get their state written. `U`: the phase is unknown
+/// ([`Phase::Unknown`]; a constant, so the zero-phase path is the code it always was).
 #[inline(always)]
-fn update_loop<const KEEP: bool>(
+fn update_loop<const KEEP: bool, const U: bool>(
     ctx: &UpdateCtx<'_>,
     st: &mut UpdateState<'_>,
     exists: &mut [bool],
@@ -325,7 +330,7 @@ fn update_loop<const KEEP: bool>(
             }
             continue;
         }
-        left = ctx.other(st, flag, slot, i, left);
+        left = ctx.other::<U>(st, flag, slot, i, left);
     }
 }
 
@@ -360,7 +365,7 @@ impl UpdateCtx<'_> {
     /// [`update_present`](Self::update_present) or [`absent`](Self::absent). Returns the
     /// new gap.
     #[inline(never)]
-    fn other(
+    fn other<const U: bool>(
         &self,
         st: &mut UpdateState<'_>,
         flag: &mut bool,
@@ -372,7 +377,7 @@ impl UpdateCtx<'_> {
         let mut rng = st.rng.clone();
         let present = predicted_existence(self.draw, self.births, e, &mut rng, &mut left);
         if present {
-            let (r, log_c) = self.update_present(slot, e, rng, st.cache);
+            let (r, log_c) = self.update_present::<U>(slot, e, rng, st.cache);
             rng = r;
             if let Some(log_c) = log_c {
                 st.rng = rng;
@@ -401,7 +406,7 @@ impl UpdateCtx<'_> {
     /// on a rejection leaves `slot` untouched. Inlined into the out-of-line
     /// [`other`](Self::other) (one call layer per present particle, not two).
     #[inline(always)]
-    fn update_present(
+    fn update_present<const U: bool>(
         &self,
         slot: &mut Particle,
         existed: bool,
@@ -439,20 +444,36 @@ impl UpdateCtx<'_> {
             self.model.obs.project(self.z, x[0], x[2])
         };
         // Gate (eq. 10). r >= r_th  <=>  |<m, m^i>|^2 >= r_th^2 ||m||^2 ||m^i||^2 (no sqrt).
+        // Unknown phase: |<m, m^i>| maximised over the two frames' phases,
+        // |<z_k, h_k>| + |<z_{k-1}, h_{k-1}>|.
         let r_th = self.cfg.r_th;
-        let num2 = (pr.zh + par_zh).norm_sqr();
+        let num2 = if U {
+            let n = math::hypot(pr.zh.re, pr.zh.im) + math::hypot(par_zh.re, par_zh.im);
+            n * n
+        } else {
+            (pr.zh + par_zh).norm_sqr()
+        };
         let den2 = self.norm_m2 * (pr.hh + par_hh);
         let pass = if den2.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
             r_th <= 0.0 // r = 0
         } else if num2.is_finite() && den2.is_finite() {
             num2 >= self.r_th2 * den2
         } else {
-            (pr.zh + par_zh).norm() / math::sqrt(den2) >= r_th
+            let num = if U {
+                math::hypot(pr.zh.re, pr.zh.im) + math::hypot(par_zh.re, par_zh.im)
+            } else {
+                (pr.zh + par_zh).norm()
+            };
+            num / math::sqrt(den2) >= r_th
         };
         if !pass {
             return (rng, None);
         }
-        let d2 = pr.residual_norm2(self.zz);
+        let d2 = if U {
+            pr.residual_norm2_unknown_phase(self.zz)
+        } else {
+            pr.residual_norm2(self.zz)
+        };
         let log_c = if self.ln_free {
             d2
         } else {
@@ -472,7 +493,7 @@ impl UpdateCtx<'_> {
 /// (`existed`) or of a birth from `U(I_x0)`. Inlined into the out-of-line
 /// [`RiskCtx::other`].
 #[inline(always)]
-fn risk_present(
+fn risk_present<const U: bool>(
     model: &Model,
     z: &[Complex32],
     zz: f32,
@@ -488,12 +509,18 @@ fn risk_present(
     };
     // BirthGaps land anywhere in the band: projected directly (a cache entry would be used
     // once).
-    let pr = if existed {
-        model.obs.project_cached::<false>(cache, z, xp[0], xp[2])
-    } else {
-        model.obs.project_re(z, xp[0], xp[2])
+    // Unknown phase (`U`): the cost needs |<z, h>|, the full projection.
+    let pr = match (existed, U) {
+        (true, false) => model.obs.project_cached::<false>(cache, z, xp[0], xp[2]),
+        (true, true) => model.obs.project_cached::<true>(cache, z, xp[0], xp[2]),
+        (false, false) => model.obs.project_re(z, xp[0], xp[2]),
+        (false, true) => model.obs.project(z, xp[0], xp[2]),
     };
-    let d2 = pr.residual_norm2(zz);
+    let d2 = if U {
+        pr.residual_norm2_unknown_phase(zz)
+    } else {
+        pr.residual_norm2(zz)
+    };
     (rng, d2)
 }
 
@@ -503,7 +530,7 @@ fn risk_present(
 /// and its pointers in registers.
 #[inline(never)]
 #[allow(clippy::too_many_arguments)]
-fn risk_pass(
+fn risk_pass<const U: bool>(
     model: &Model,
     z: &[Complex32],
     zz: f32,
@@ -546,7 +573,7 @@ fn risk_pass(
             *o = zz_floor;
             continue;
         }
-        let (l, v) = ctx.other(&mut st, e, &p.x, left);
+        let (l, v) = ctx.other::<U>(&mut st, e, &p.x, left);
         left = l;
         *o = v;
     }
@@ -581,11 +608,17 @@ impl RiskCtx<'_> {
     /// (`left = 0`): its predicted existence, its residual (`||z||^2` floored if absent)
     /// and the new gap.
     #[inline(never)]
-    fn other(&self, st: &mut RiskState<'_>, e: bool, x: &[f32; 3], mut left: u32) -> (u32, f32) {
+    fn other<const U: bool>(
+        &self,
+        st: &mut RiskState<'_>,
+        e: bool,
+        x: &[f32; 3],
+        mut left: u32,
+    ) -> (u32, f32) {
         let mut rng = st.rng.clone();
         let present = predicted_existence(self.draw, self.births, e, &mut rng, &mut left);
         let v = if present {
-            let (r, d2) = risk_present(self.model, self.z, self.zz, x, e, rng, st.cache);
+            let (r, d2) = risk_present::<U>(self.model, self.z, self.zz, x, e, rng, st.cache);
             rng = r;
             st.n_present += 1;
             // Not f32::min: that is a call to fminf on the M4 (no VMINNM); d2 is never
@@ -698,17 +731,31 @@ impl<const N: usize> CrpfTbd<N> {
     /// `self.parts`.
     fn predict_and_resample(&mut self, z: &[Complex32], zz: f32, ln_lambda: f32) {
         // Squared residual of every predicted particle, and the smallest.
-        let dmin = risk_pass(
-            &self.model,
-            z,
-            zz,
-            &self.exists,
-            &self.parts,
-            &mut self.log_w,
-            &mut self.rng,
-            &self.births,
-            &mut self.cache,
-        );
+        // The phase model as a constant of the pass (one copy of the loop per model).
+        let dmin = match self.model.phase {
+            Phase::Zero => risk_pass::<false>(
+                &self.model,
+                z,
+                zz,
+                &self.exists,
+                &self.parts,
+                &mut self.log_w,
+                &mut self.rng,
+                &self.births,
+                &mut self.cache,
+            ),
+            Phase::Unknown => risk_pass::<true>(
+                &self.model,
+                z,
+                zz,
+                &self.exists,
+                &self.parts,
+                &mut self.log_w,
+                &mut self.rng,
+                &self.births,
+                &mut self.cache,
+            ),
+        };
         if let Some(n) = self.int_exponent {
             // w_i = (min d2 / d2_i)^(q p / 2): eq. 4 normalised by its largest weight,
             // summed on the way (the compensated sum `resample` would compute).
@@ -833,10 +880,13 @@ impl<const N: usize> CrpfTbd<N> {
         };
         // With lambda = 0 an absent particle's state is never read again: only its flag
         // is written (and it is already `false`).
-        if self.cfg.lambda > 0.0 {
-            update_loop::<true>(&ctx, &mut st, &mut self.exists, &mut self.parts, left);
-        } else {
-            update_loop::<false>(&ctx, &mut st, &mut self.exists, &mut self.parts, left);
+        let (keep, unknown) = (self.cfg.lambda > 0.0, self.model.phase == Phase::Unknown);
+        let (ex, parts) = (&mut self.exists, &mut self.parts);
+        match (keep, unknown) {
+            (true, false) => update_loop::<true, false>(&ctx, &mut st, ex, parts, left),
+            (false, false) => update_loop::<false, false>(&ctx, &mut st, ex, parts, left),
+            (true, true) => update_loop::<true, true>(&ctx, &mut st, ex, parts, left),
+            (false, true) => update_loop::<false, true>(&ctx, &mut st, ex, parts, left),
         }
         let (count, best, arg) = (st.count, st.best, st.arg);
         self.rng = st.rng;

@@ -5,6 +5,7 @@
 //! reset:     x_i ~ draw(prior)                             (per detector: E_0, U(I_x0))
 //! predict:   x_i <- move(x_i)   (per detector: F x + G v of eq. 16, births from U(I_x0))
 //! weigh:     ln w_i = (2 Re<z,h(x_i)> - ||h(x_i)||^2) / s2   if x_i holds a target,
+//!                   (phase unknown: ln I0(2 |<z,h(x_i)>| / s2) - ||h(x_i)||^2 / s2)
 //!            ln w_i = 0                                       otherwise
 //! normalise: w_i = exp(ln w_i - LSE),  LSE = ln sum_i exp(ln w_i)   (log domain)
 //! estimate:  sum_i w_i x_i / sum_i w_i over the particles holding a target (band wrap)
@@ -14,7 +15,9 @@
 
 use crate::detect::Validate;
 use crate::math;
-use crate::model::doppler::{check_frame, DopplerModel, DopplerReport, Model, ModelConfig, Motion};
+use crate::model::doppler::{
+    check_frame, DopplerModel, DopplerReport, Model, ModelConfig, Motion, Phase,
+};
 use crate::particles::{gather_in_place, resample, Scheme};
 use crate::rng::Rng;
 use crate::{Complex32, Error, Result};
@@ -157,6 +160,19 @@ pub(crate) fn log_mass(x: f32) -> f32 {
         math::ln(x)
     } else {
         f32::NEG_INFINITY
+    }
+}
+
+/// A target's log likelihood ratio against the frame under the model's phase:
+/// `(2 Re<z,h> - ||h||^2) / s2` (zero phase; `Re <z,h>` only) or the Rician
+/// `ln I0(2 |<z,h>| / s2) - ||h||^2 / s2` (unknown phase; the full projection).
+/// `U`: the phase is unknown ([`Phase::Unknown`]; a constant of the frame's loop).
+#[inline(always)]
+fn log_lr_of<const U: bool>(m: &Model, z: &[Complex32], x: [f32; 3], inv_var: f32) -> f32 {
+    if U {
+        m.obs.project(z, x[0], x[2]).log_lr_unknown_phase(inv_var)
+    } else {
+        m.obs.project_re(z, x[0], x[2]).log_lr(inv_var)
     }
 }
 
@@ -307,15 +323,30 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
         mut step: impl FnMut(&mut P, &Model, &mut Rng),
     ) -> Result<()> {
         check_frame(z, self.model.obs.bins())?;
+        // The phase model as a constant of the loop (one copy per model).
+        match self.model.phase {
+            Phase::Zero => self.weigh_all::<false>(z, &mut step),
+            Phase::Unknown => self.weigh_all::<true>(z, &mut step),
+        }
+        Ok(())
+    }
+
+    /// The loop of [`predict_and_weigh`](Self::predict_and_weigh) for the phase model `U`
+    /// (its own function: the detectors' step stays the size it was).
+    #[inline(never)]
+    fn weigh_all<const U: bool>(
+        &mut self,
+        z: &[Complex32],
+        step: &mut impl FnMut(&mut P, &Model, &mut Rng),
+    ) {
         let m = &self.model;
         for (p, lw) in self.parts.iter_mut().zip(self.log_w.iter_mut()) {
             step(p, m, &mut self.rng);
             *lw = match p.target() {
-                Some(x) => m.obs.project_re(z, x[0], x[2]).log_lr(self.inv_var),
+                Some(x) => log_lr_of::<U>(m, z, x, self.inv_var),
                 None => 0.0,
             };
         }
-        Ok(())
     }
 
     /// [`predict_and_weigh`](Self::predict_and_weigh) for a fixed-share birth proposal:
@@ -334,6 +365,22 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
         mut step: impl FnMut(&mut P, bool, &Model, &mut Rng) -> f32,
     ) -> Result<()> {
         check_frame(z, self.model.obs.bins())?;
+        match self.model.phase {
+            Phase::Zero => self.weigh_split::<false>(z, births, &mut step),
+            Phase::Unknown => self.weigh_split::<true>(z, births, &mut step),
+        }
+        Ok(())
+    }
+
+    /// The loop of [`predict_and_weigh_split`](Self::predict_and_weigh_split) for the
+    /// phase model `U` (its own function, as `weigh_all`).
+    #[inline(never)]
+    fn weigh_split<const U: bool>(
+        &mut self,
+        z: &[Complex32],
+        births: u32,
+        step: &mut impl FnMut(&mut P, bool, &Model, &mut Rng) -> f32,
+    ) {
         let m = &self.model;
         // 2 <= N <= 2^31 and births < N (birth_count): acc + births < 2^32, and acc stays
         // below N after each step.
@@ -347,11 +394,10 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
             }
             let prior = step(p, birth_slot, m, &mut self.rng);
             *lw = match p.target() {
-                Some(x) => prior + m.obs.project_re(z, x[0], x[2]).log_lr(self.inv_var),
+                Some(x) => prior + log_lr_of::<U>(m, z, x, self.inv_var),
                 None => prior,
             };
         }
-        Ok(())
     }
 
     /// Particles without a target.

@@ -8,7 +8,9 @@
 //! p(z_k | Z_{k-1}, H1) / p(z_k | H0) ≈ (1/N) sum_i exp((2 Re<z_k,h_i> - ||h_i||^2) / s2)
 //! ln L_K = sum_k ln[(1/N) sum_i LR_i^k]          (accumulated in the log domain)
 //! ```
-//! Noise assumed complex Gaussian, independent bins, variance `s2`. The report's
+//! Noise assumed complex Gaussian, independent bins, variance `s2`; with
+//! [`Phase::Unknown`](crate::model::doppler::Phase) `LR_i` is averaged over a uniform
+//! phase per frame, `ln I0(2 |<z_k,h_i>| / s2) - ||h_i||^2 / s2` (Rician). The report's
 //! `log_lr` is `ln L_k`; its `existence` is the per-frame evidence
 //! `1 / (1 + exp(-l_k))` of this frame's increment `l_k`.
 

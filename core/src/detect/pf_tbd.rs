@@ -29,7 +29,9 @@
 //! Noise model assumed: independent complex Gaussian bins of variance `s2` (given, or
 //! estimated from the K frames with
 //! [`estimate_noise_variance`](crate::model::doppler::estimate_noise_variance)). Weights
-//! are normalised in the log domain.
+//! are normalised in the log domain. With
+//! [`Phase::Unknown`](crate::model::doppler::Phase) the likelihood ratio is averaged over
+//! a uniform phase per frame: `ln LR = ln I0(2 |<z,h>| / s2) - ||h||^2 / s2` (Rician).
 
 use super::gauss_cloud::{gauss_detector, log_mass, CloudParticle, GaussianCloud};
 use crate::existence::Transition;

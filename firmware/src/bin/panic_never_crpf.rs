@@ -34,7 +34,7 @@ use faint_core::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd};
 use faint_core::detect::{run as run_frames, Detector, Validate};
 use faint_core::model::doppler::{
     check_frame, dtft, estimate_noise_variance, max_amplitude, unwindow, DopplerModel, ModelConfig,
-    ProjectionCache, Window, MAX_BINS, SPAN,
+    Phase, ProjectionCache, Window, MAX_BINS, SPAN,
 };
 use faint_core::rng::Rng;
 use faint_core::Complex32;
@@ -279,6 +279,13 @@ fn family<const N: usize>(
             p: black_box(2.0),
             ..paper
         },
+        CrpfConfig {
+            model: ModelConfig {
+                phase: black_box(Phase::Unknown),
+                ..hamming
+            },
+            ..paper
+        },
     ];
     for (i, cfg) in crpf_cfgs.iter().enumerate() {
         ok &= crpf.configure(cfg, black_box(i as u64)).is_ok();
@@ -321,10 +328,18 @@ fn family<const N: usize>(
         birth: BirthProposal::FixedShare(black_box(0.1)),
         ..ham
     };
+    let unknown = GaussConfig {
+        model: ModelConfig {
+            phase: black_box(Phase::Unknown),
+            ..hamming
+        },
+        ..shared
+    };
     for (cfg, model, whiten) in [
         (ham, &model_h, None),
         (white, &model_r, Some(Window::Hamming)),
         (shared, &model_h, None),
+        (unknown, &model_h, None),
     ] {
         ok &= pf.configure(&cfg, black_box(1)).is_ok();
         ok &= exercise(pf, model, whiten, rng);
@@ -487,6 +502,9 @@ fn model_functions(rng: &mut Rng) -> bool {
             let c2 = model.project_cached::<false>(cache, zs, fd, 0.7);
             acc += p.zh.im + r.hh + c.zh.re + c2.hh;
             acc += p.residual_norm2(black_box(3.0)) + r.log_lr(black_box(0.1));
+            acc += p.residual_norm2_unknown_phase(black_box(3.0))
+                + c.log_lr_unknown_phase(black_box(0.1))
+                + faint_core::math::ln_i0(black_box(acc));
         }
         let (re, im) = dtft(win, bins, black_box(0.3));
         acc += (re + im) as f32;

@@ -6,7 +6,7 @@ use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint_core::detect::Detector;
-use faint_core::model::doppler::{ModelConfig, Window};
+use faint_core::model::doppler::{ModelConfig, Phase, Window};
 use faint_core::Complex32;
 use serde::{Deserialize, Serialize};
 
@@ -77,14 +77,18 @@ fn window_energy(window: Window, m: usize) -> f64 {
     (0..m).map(|n| window.coefficient(n, m).powi(2)).sum()
 }
 
-/// CRPF-TBD's default configuration file: the OTHR preset, 1000 particles.
+/// CRPF-TBD's default configuration file: the OTHR preset, 1000 particles, an unknown
+/// phase per frame (recorded echoes; the preset's zero phase is the paper's model).
 pub(super) fn default_crpf() -> String {
-    let c = CrpfConfig::othr();
+    let mut c = CrpfConfig::othr();
+    c.model.phase = Phase::Unknown;
     json(&doppler_defaults(1000, c, &c.model))
 }
 
+/// The Gaussian comparators' default configuration file: as [`default_crpf`].
 pub(super) fn default_gauss() -> String {
-    let c = GaussConfig::othr(1.0);
+    let mut c = GaussConfig::othr(1.0);
+    c.model.phase = Phase::Unknown;
     json(&doppler_defaults(1000, c, &c.model))
 }
 

@@ -23,8 +23,13 @@
 //! ||z - h||^2 = ||z||^2 - 2 Re <z, h> + ||h||^2,   <z, h> = sum_b conj(z_b) h_b
 //! ```
 //!
-//! over those five bins ([`DopplerModel::project`]). Within one frame the five-bin sums
-//! of a table row are linear in the interpolation fraction `f`:
+//! over those five bins ([`DopplerModel::project`]). With an unknown phase per frame
+//! ([`Phase::Unknown`], `A e^{j phi}` in eq. 17) the cost is the minimum over `phi`,
+//! `||z||^2 - 2 |<z, h>| + ||h||^2`, and the Gaussian likelihood ratio its average,
+//! `ln I0(2 |<z, h>| / s2) - ||h||^2 / s2` ([`Projection`]).
+//!
+//! Within one frame the five-bin sums of a table row are linear in the interpolation
+//! fraction `f`:
 //! `<z, h> / A = sum_j conj(z_j) a_j + f sum_j conj(z_j) d_j` (`a_j`, `d_j` the row's
 //! points and slopes) and `||h||^2 / A^2 = H0 + f (H1 + f H2)` (per row, computed once in
 //! `f64`), so [`DopplerModel::project_cached`] keeps the two complex sums per (first bin,
@@ -51,7 +56,7 @@ mod whiten;
 pub use cache::ProjectionCache;
 pub use motion::{Motion, PriorBox};
 pub use response::{
-    dtft, DopplerModel, Projection, Window, HALF_SPAN, MAX_BINS, RESPONSE_ERROR_BOUND, SPAN,
+    dtft, DopplerModel, Phase, Projection, Window, HALF_SPAN, MAX_BINS, RESPONSE_ERROR_BOUND, SPAN,
     TABLE_STEPS,
 };
 pub use whiten::unwindow;
@@ -135,13 +140,20 @@ pub struct ModelConfig {
     pub death: f32,
     /// `P(E_0 = 1)` of the initial particles (and the initial existence of JOTT).
     pub initial_existence: f32,
+    /// The target's phase at each frame's start ([`Phase`]): `zero` (eq. 17, the paper
+    /// and the presets) or `unknown` (CRPF-TBD's cost minimised over it, the Gaussian
+    /// comparators' likelihood ratio averaged over it). Absent in a configuration file
+    /// means `zero`, the model files written before the option existed were run with
+    /// (`faint detect --print-config` writes `unknown`, its default).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub phase: Phase,
 }
 
 impl ModelConfig {
     /// The OTHR preset of the spec: `m = 32`, `ts = 0.02 s`, Hamming window, Doppler band
     /// `[-25, 25)` Hz, `fda in [-0.5, 0.5]` Hz/s, amplitude box `[0.05, 1.5]` (unit time-domain
     /// noise variance: SNR about -13 dB to +17 dB by eq. 18), `v1` std 0.2 Hz/s^2, `v2` std
-    /// 0.02 1/s, `Pb = Pd = 0.05`, `P(E_0 = 1) = 0.05`.
+    /// 0.02 1/s, `Pb = Pd = 0.05`, `P(E_0 = 1) = 0.05`, zero phase (eq. 17).
     pub fn othr() -> Self {
         Self {
             bins: 32,
@@ -157,6 +169,7 @@ impl ModelConfig {
             birth: 0.05,
             death: 0.05,
             initial_existence: 0.05,
+            phase: Phase::Zero,
         }
     }
 
@@ -217,6 +230,7 @@ impl ModelConfig {
             chain,
             prior: self.prior,
             initial_existence: self.initial_existence,
+            phase: self.phase,
         })
     }
 }
@@ -241,6 +255,8 @@ pub struct Model {
     pub prior: PriorBox,
     /// `P(E_0 = 1)`.
     pub initial_existence: f32,
+    /// The phase model of the cost / likelihood ratio.
+    pub phase: Phase,
 }
 
 /// What every Doppler-frame detector (CRPF-TBD, PF-TBD, JOTT, PF-LRT) reports per frame.

@@ -58,6 +58,36 @@ impl Window {
     }
 }
 
+/// The target's carrier phase at the start of each frame, as the observation model
+/// assumes it (the detectors' [`ModelConfig::phase`](super::ModelConfig::phase)).
+///
+/// ```text
+/// Zero:     z = DFT_W(A exp(j 2 pi fd n ts)) + noise, A real           (eq. 17)
+///           cost ||z - h||^2 = ||z||^2 - 2 Re<z,h> + ||h||^2
+///           log-LR (2 Re<z,h> - ||h||^2) / s2
+/// Unknown:  the same with A exp(j phi), phi uniform and independent per frame
+///           cost min_phi ||z - h e^{j phi}||^2 = ||z||^2 - 2 |<z,h>| + ||h||^2
+///           log-LR ln E_phi[LR] = ln I0(2 |<z,h>| / s2) - ||h||^2 / s2    (Rician)
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "kebab-case")
+)]
+pub enum Phase {
+    /// Zero at every frame's start: a real amplitude (eq. 17 of Lu, Wang, Zhang 2017),
+    /// the paper's model and the presets' (`ModelConfig::othr`). The default, and what a
+    /// configuration without the key means (the model of every file written before the
+    /// option existed).
+    #[default]
+    Zero,
+    /// Unknown and independent from frame to frame (independent dwells, the real echo):
+    /// CRPF-TBD minimises its cost over the phase, the Gaussian comparators average
+    /// their likelihood ratio over it.
+    Unknown,
+}
+
 /// `<z, h>` and `||h||^2` of one hypothesised target against one frame.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Projection {
@@ -85,6 +115,52 @@ impl Projection {
     #[inline]
     pub fn log_lr(&self, inv_var: f32) -> f32 {
         (2.0 * self.zh.re - self.hh) * inv_var
+    }
+
+    /// `min_phi ||z - h e^{j phi}||^2 = zz - 2 |<z,h>| + ||h||^2`, floored at
+    /// `f32::MIN_POSITIVE` as [`residual_norm2`](Self::residual_norm2) (needs `Im <z,h>`:
+    /// a full projection).
+    #[inline]
+    pub fn residual_norm2_unknown_phase(&self, zz: f32) -> f32 {
+        let d = zz - 2.0 * math::hypot(self.zh.re, self.zh.im) + self.hh;
+        if d > f32::MIN_POSITIVE {
+            d
+        } else {
+            f32::MIN_POSITIVE
+        }
+    }
+
+    /// The log likelihood ratio averaged over a uniform phase (Rician):
+    /// `ln I0(2 |<z,h>| / s2) - ||h||^2 / s2`, computed as
+    /// `(2 |<z,h>| - ||h||^2) / s2 + ln(e^-x I0(x))`, `x = 2 |<z,h>| / s2` (clamped to
+    /// `f32::MAX`), so no intermediate overflows where the zero-phase form does not
+    /// (needs `Im <z,h>`: a full projection).
+    #[inline]
+    pub fn log_lr_unknown_phase(&self, inv_var: f32) -> f32 {
+        let r = math::hypot(self.zh.re, self.zh.im);
+        let x = 2.0 * r * inv_var;
+        let x = if x < f32::MAX { x } else { f32::MAX };
+        (2.0 * r - self.hh) * inv_var + math::ln_i0e(x)
+    }
+
+    /// The cost of the phase model: [`residual_norm2`](Self::residual_norm2) or
+    /// [`residual_norm2_unknown_phase`](Self::residual_norm2_unknown_phase).
+    #[inline(always)]
+    pub fn cost(&self, zz: f32, phase: Phase) -> f32 {
+        match phase {
+            Phase::Zero => self.residual_norm2(zz),
+            Phase::Unknown => self.residual_norm2_unknown_phase(zz),
+        }
+    }
+
+    /// The log likelihood ratio of the phase model: [`log_lr`](Self::log_lr) or
+    /// [`log_lr_unknown_phase`](Self::log_lr_unknown_phase).
+    #[inline(always)]
+    pub fn log_lr_for(&self, inv_var: f32, phase: Phase) -> f32 {
+        match phase {
+            Phase::Zero => self.log_lr(inv_var),
+            Phase::Unknown => self.log_lr_unknown_phase(inv_var),
+        }
     }
 }
 
@@ -410,6 +486,134 @@ fn dtft_of(w: impl Iterator<Item = f64>, theta: f64) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rng::Rng;
+
+    /// A frame of 32 bins: complex Gaussian noise plus a target at `fd` with amplitude
+    /// `amp` and carrier phase `phi`.
+    fn frame(model: &DopplerModel, fd: f32, amp: f32, phi: f32, seed: u64) -> [Complex32; 32] {
+        let mut rng = Rng::seed_from_u64(seed);
+        let mut z = [Complex32::new(0.0, 0.0); 32];
+        for c in z.iter_mut() {
+            *c = Complex32::new(rng.normal(), rng.normal());
+        }
+        let mut h = [Complex32::new(0.0, 0.0); SPAN];
+        let first = model.response(fd, amp, &mut h);
+        let rot = Complex32::new(math::cos(phi), math::sin(phi));
+        for (j, v) in h.iter().enumerate() {
+            if let Some(c) = z.get_mut((first + j) % 32) {
+                *c += *v * rot;
+            }
+        }
+        z
+    }
+
+    /// The unknown-phase cost and likelihood ratio depend on `|<z,h>|` only: rotating the
+    /// whole frame by `e^{j phi}` leaves them unchanged (up to `f32` rounding), while the
+    /// zero-phase cost moves.
+    #[test]
+    fn unknown_phase_observation_is_invariant_to_the_frame_phase() {
+        let model = DopplerModel::new(32, 0.02, Window::Hamming).expect("valid model");
+        for seed in 0..20u64 {
+            let fd = -20.0 + 2.0 * seed as f32;
+            let z = frame(&model, fd, 0.8, 0.3 * seed as f32, seed);
+            let zz: f32 = z.iter().map(|c| c.norm_sqr()).sum();
+            let base = model.project(&z, fd + 0.1, 0.7);
+            let (c0, l0) = (
+                base.residual_norm2_unknown_phase(zz),
+                base.log_lr_unknown_phase(0.5),
+            );
+            let mut zero_costs = [0.0f32; 16];
+            for (i, zc) in zero_costs.iter_mut().enumerate() {
+                let phi = i as f32 * (2.0 * math::PI / 16.0);
+                let rot = Complex32::new(math::cos(phi), math::sin(phi));
+                let zr: [Complex32; 32] = core::array::from_fn(|b| z[b] * rot);
+                let pr = model.project(&zr, fd + 0.1, 0.7);
+                let c = pr.residual_norm2_unknown_phase(zz);
+                let l = pr.log_lr_unknown_phase(0.5);
+                assert!(
+                    (c - c0).abs() <= 1e-5 * c0,
+                    "seed {seed}, phi {phi}: {c} vs {c0}"
+                );
+                assert!((l - l0).abs() <= 1e-5 * (1.0 + l0.abs()), "{l} vs {l0}");
+                assert!(
+                    c <= pr.residual_norm2(zz) * (1.0 + 1e-6),
+                    "the minimum over phi"
+                );
+                *zc = pr.residual_norm2(zz);
+            }
+            let (lo, hi) = zero_costs
+                .iter()
+                .fold((f32::MAX, 0.0f32), |(a, b), &c| (a.min(c), b.max(c)));
+            assert!(hi - lo > 0.1, "the zero-phase cost depends on the phase");
+        }
+    }
+
+    /// The Rician log-LR is the log of the zero-phase likelihood ratio averaged over a
+    /// uniform phase, computed in `f64` (4096-point rule on the circle, exact to far
+    /// below the tolerance for `x = 2 |<z,h>| / s2` up to the 6400 tested): absolute error below
+    /// `1e-5 (1 + x)` (the `f32` rounding of `(2 |<z,h>| - ||h||^2) / s2`).
+    #[test]
+    fn rician_log_lr_is_the_phase_average_of_the_zero_phase_lr() {
+        let mut rng = Rng::seed_from_u64(3);
+        for i in 0..400 {
+            let r = math::powf(10.0, rng.uniform_range(-4.0, 2.5));
+            let th = rng.uniform_range(-math::PI, math::PI);
+            let hh = r * rng.uniform_range(0.0, 3.0);
+            let inv_var = math::powf(10.0, rng.uniform_range(-1.0, 1.0));
+            let pr = Projection {
+                zh: Complex32::new(r * math::cos(th), r * math::sin(th)),
+                hh,
+            };
+            let got = pr.log_lr_unknown_phase(inv_var) as f64;
+            let (zr, zi, hh, s) = (pr.zh.re as f64, pr.zh.im as f64, hh as f64, inv_var as f64);
+            let n = 4096;
+            let logs: [f64; 4096] = core::array::from_fn(|j| {
+                let phi = 2.0 * core::f64::consts::PI * j as f64 / n as f64;
+                // Re(e^{j phi} <z,h>), the zero-phase log-LR of the rotated target.
+                let re = zr * libm::cos(phi) - zi * libm::sin(phi);
+                (2.0 * re - hh) * s
+            });
+            let mx = logs.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            let sum: f64 = logs.iter().map(|l| libm::exp(l - mx)).sum();
+            let want = mx + libm::log(sum / n as f64);
+            let x = 2.0 * libm::hypot(zr, zi) * s;
+            assert!(
+                (got - want).abs() <= 1e-5 * (1.0 + x),
+                "case {i}: x = {x}, got {got}, want {want}"
+            );
+        }
+    }
+
+    /// The zero-phase cost and log-LR are the formulas they always were, bit for bit.
+    #[test]
+    fn zero_phase_observation_is_unchanged() {
+        assert_eq!(Phase::default(), Phase::Zero);
+        let pr = Projection {
+            zh: Complex32::new(1.25, -0.5),
+            hh: 0.75,
+        };
+        let zz = 3.0f32;
+        assert_eq!(
+            pr.cost(zz, Phase::Zero).to_bits(),
+            (zz - 2.5 + 0.75f32).to_bits()
+        );
+        assert_eq!(pr.cost(zz, Phase::Zero), pr.residual_norm2(zz));
+        assert_eq!(
+            pr.log_lr_for(0.5, Phase::Zero).to_bits(),
+            ((2.5f32 - 0.75) * 0.5).to_bits()
+        );
+        assert_eq!(pr.log_lr_for(0.5, Phase::Zero), pr.log_lr(0.5));
+        let r = libm::hypotf(1.25, -0.5);
+        let want = zz - 2.0 * r + 0.75;
+        assert!((pr.cost(zz, Phase::Unknown) - want).abs() < 1e-6);
+        // Both floored alike: z = j h (||h||^2 = 4) fits exactly at phase pi/2 only.
+        let fit = Projection {
+            zh: Complex32::new(0.0, 4.0),
+            hh: 4.0,
+        };
+        assert_eq!(fit.cost(4.0, Phase::Unknown), f32::MIN_POSITIVE);
+        assert_eq!(fit.cost(4.0, Phase::Zero), 8.0);
+    }
 
     /// The table is built with one `sincos` per sample and the window's coefficients
     /// computed once; the reference below is the textbook form (a `cos`, a `sin` and the
