@@ -212,9 +212,9 @@ fn every_detector_with_a_simulator_runs_the_harness() {
 /// The SNRs and shares: docs/detect.md's table measures (same seed, 200 runs) Pd 0.9 at
 /// 9.5 (crpf), 8.7 (jott), 8.9 (pf-tbd) and 4.4 dB (pf-lrt) with the phase the Doppler
 /// models assume (zero at each frame's start), 12.2 dB for MHT-TBD, 15.5 dB for
-/// DP-Pulford; the test asks Pd >= 0.8 at a few dB above those, where the measured Pd is
-/// >= 0.96 and 0.8 is more than 6 standard deviations (sqrt(0.04 0.96 / 200) = 0.014)
-/// below it. A random phase per frame (the default simulator) is the real echo; the
+/// DP-Pulford; the test asks Pd >= 0.8 at a few dB above those, where the measured Pd
+/// is at least 0.96 and 0.8 is more than 6 standard deviations (sqrt(0.04 0.96 / 200) =
+/// 0.014) below it. A random phase per frame (the default simulator) is the real echo; the
 /// Doppler models lose it (Pd <= 0.7 up to 30 dB, the table), so this test fixes the
 /// phase to what they assume and the table states both.
 #[test]
@@ -244,9 +244,9 @@ fn calibrated_detectors_detect_on_physical_data() {
 /// run) at Pfa 0.1 on 100 runs: its false-alarm count is the one the calibration
 /// predicts, and Pd rises with SNR from 4 to 16 dB (peak-cell SNR). At 4 dB a cell's
 /// SNR is below the births' 4-12 dB prior and the target rarely confirms within 5
-/// frames (measured 0 at this seed); at 16 dB it does in most runs (measured 0.79): the test asks a
-/// rise of 0.3, more than 6 standard deviations of the difference of two proportions on
-/// 100 runs (at most sqrt(2 * 0.25 / 100) = 0.07).
+/// frames (measured Pd 0 at this seed); at 16 dB it does in most runs (measured 0.79).
+/// The test asks a rise of 0.3, more than 4 standard deviations of the difference of
+/// two proportions on 100 runs (at most sqrt(2 * 0.25 / 100) = 0.07).
 #[test]
 fn phd_on_physical_cubes_pd_rises_with_snr() {
     faint::host::montecarlo::set_quiet(true);

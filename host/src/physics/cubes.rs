@@ -384,7 +384,7 @@ mod tests {
         assert!((mean - 1.0).abs() < 0.005, "{mean}");
         for th in [0.5, 1.0, 2.0, 4.0] {
             let got = x.iter().filter(|&&v| v > th).count() as f64 / x.len() as f64;
-            assert!((got - (-th as f64).exp()).abs() < 0.003, "P(>{th}) = {got}");
+            assert!((got - (-th).exp()).abs() < 0.003, "P(>{th}) = {got}");
         }
     }
 

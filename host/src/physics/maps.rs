@@ -357,7 +357,7 @@ mod tests {
             .collect();
         for th in [0.5, 1.0, 2.0, 3.0] {
             let got = one.iter().filter(|&&v| v > th).count() as f64 / one.len() as f64;
-            assert!((got - (-th as f64).exp()).abs() < 0.02, "P(>{th}) = {got}");
+            assert!((got - (-th).exp()).abs() < 0.02, "P(>{th}) = {got}");
         }
     }
 
