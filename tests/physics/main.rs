@@ -90,6 +90,11 @@ fn bad_arguments_are_refused() {
             "--swerling",
         ),
         (
+            // The default cube, 7.7 MB per frame: 200 runs of 10 frames are 15 GB.
+            vec!["evaluate", "phd-tbd", "--pfa", "0.05"],
+            "calibration file would hold",
+        ),
+        (
             vec![
                 "evaluate",
                 "cbmember",

@@ -94,6 +94,10 @@ fn beta_binomial_interval(m: usize, a: f64, b: f64) -> (usize, usize) {
 /// Runs per file (and per parallel task).
 pub const GROUP: usize = 25;
 
+/// Largest calibration set (bytes of `f32` frames) `faint evaluate` simulates: it is held
+/// in memory and written as one file.
+pub const MAX_CALIBRATION_BYTES: f64 = 2e9;
+
 /// Command line of `faint evaluate`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
@@ -319,6 +323,19 @@ pub fn run(a: &Args) -> Result<Evaluation> {
         (None, Physics::Cubes(_) | Physics::Maps(_)) => 10,
     };
     crate::cli::count("--frames", l, 1..=100_000)?;
+    if let Some(shape) = phys.frame_shape() {
+        // The calibration's runs are held in memory and written as one file.
+        let bytes = 4.0 * a.runs as f64 * l as f64 * shape.iter().product::<usize>() as f64;
+        ensure!(
+            bytes <= MAX_CALIBRATION_BYTES,
+            "--runs {} x --frames {l} frames of {shape:?} cells: the calibration file would \
+             hold {:.1} GB (at most {:.0}); use fewer runs or frames, or a smaller geometry \
+             in --config",
+            a.runs,
+            bytes / 1e9,
+            MAX_CALIBRATION_BYTES / 1e9
+        );
+    }
     ensure!(
         a.burn_in < l,
         "--burn-in {} must be below --frames {l}",
