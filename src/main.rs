@@ -219,7 +219,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let ev = faint::host::physics::evaluate::run(&a)?;
             println!("SNR: {}", ev.snr_definition);
             if let Some(g) = ev.gate {
-                println!("gate: {g} ({})", ev.input);
+                println!("gate: {g} {} ({})", ev.gate_unit, ev.input);
             }
             for c in &ev.curve {
                 println!(

@@ -94,11 +94,14 @@ fn beta_binomial_interval(m: usize, a: f64, b: f64) -> (usize, usize) {
 /// Runs per file (and per parallel task).
 pub const GROUP: usize = 25;
 
+/// Largest calibration set (bytes of `f32` frames) `faint evaluate` simulates: it is held
+/// in memory and written as one file.
+pub const MAX_CALIBRATION_BYTES: f64 = 2e9;
+
 /// Command line of `faint evaluate`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
-    /// Detector, as listed by `faint detect --list` (Doppler-frame, plot and image
-    /// detectors).
+    /// Detector, as listed by `faint detect --list`.
     pub detector: String,
     /// False-alarm probability per run's final frame, in (0, 1); needs runs * pfa >= 10.
     #[arg(long)]
@@ -111,7 +114,7 @@ pub struct Args {
     #[arg(long, default_value_t = 200)]
     pub runs: usize,
     /// Frames per run `L` [default: 20 Doppler frames, the configuration's n_scans for
-    /// plots, 40 images].
+    /// plots, 40 images, 10 power cubes or maps].
     #[arg(long)]
     pub frames: Option<usize>,
     /// Frames from the start that declare nothing.
@@ -130,7 +133,7 @@ pub struct Args {
     /// continuous (one coherent signal) or zero (the presets' assumption; diagnosis only).
     #[arg(long, value_enum, default_value = "random")]
     pub phase: PhaseArg,
-    /// Swerling case of the target's amplitude, 0, 1 or 3 (Doppler frames and images).
+    /// Swerling case of the target's amplitude, 0, 1 or 3 (all but plots).
     #[arg(long, default_value_t = 0)]
     pub swerling: u8,
 }
@@ -183,6 +186,8 @@ pub struct Evaluation {
     pub frames: usize,
     /// Gate of a correct position (`None`: the detector reports no positions).
     pub gate: Option<f64>,
+    /// Its unit.
+    pub gate_unit: String,
     /// The Pd curve.
     pub curve: Vec<PdRow>,
     /// SNR (dB) at Pd 0.9 (`None`: not reached).
@@ -302,6 +307,8 @@ pub fn run(a: &Args) -> Result<Evaluation> {
             };
         }
         Physics::Images(p) => p.swerling = swerling,
+        Physics::Cubes(p) => p.swerling = swerling,
+        Physics::Maps(p) => p.swerling = swerling,
         Physics::Plots(_) => {}
     }
     let l = match (a.frames, &phys) {
@@ -313,8 +320,22 @@ pub fn run(a: &Args) -> Result<Evaluation> {
             .and_then(serde_json::Value::as_u64)
             .unwrap_or(30) as usize,
         (None, Physics::Images(_)) => 40,
+        (None, Physics::Cubes(_) | Physics::Maps(_)) => 10,
     };
     crate::cli::count("--frames", l, 1..=100_000)?;
+    if let Some(shape) = phys.frame_shape() {
+        // The calibration's runs are held in memory and written as one file.
+        let bytes = 4.0 * a.runs as f64 * l as f64 * shape.iter().product::<usize>() as f64;
+        ensure!(
+            bytes <= MAX_CALIBRATION_BYTES,
+            "--runs {} x --frames {l} frames of {shape:?} cells: the calibration file would \
+             hold {:.1} GB (at most {:.0}); use fewer runs or frames, or a smaller geometry \
+             in --config",
+            a.runs,
+            bytes / 1e9,
+            MAX_CALIBRATION_BYTES / 1e9
+        );
+    }
     ensure!(
         a.burn_in < l,
         "--burn-in {} must be below --frames {l}",
@@ -424,6 +445,7 @@ pub fn run(a: &Args) -> Result<Evaluation> {
         runs: a.runs,
         frames: l,
         gate: probe.then(|| phys.gate()),
+        gate_unit: phys.gate_unit().to_string(),
         curve,
         snr_at_09,
         snr_definition: phys.snr_definition().to_string(),

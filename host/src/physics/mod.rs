@@ -8,19 +8,24 @@
 //!   mht and hough-classic.
 //! - [`images`]: intensity images with a pixel-integrated Gaussian point-spread, for the
 //!   DP detectors.
+//! - [`cubes`]: range x Doppler x azimuth power cubes (sinc spread per axis), for the
+//!   PHD family.
+//! - [`maps`]: range x velocity power maps (pulses, window, FFT across them), for
+//!   CBMeMBer.
 //!
-//! Power cubes and power maps have no simulator here yet ([`Physics::for_detector`]
-//! refuses them). Each file's docs state its conventions (DFT sign, bin order, cell and
-//! pixel centres, units); docs/detect.md repeats them under "Conventions".
+//! Each file's docs state its conventions (DFT sign, bin order, cell and pixel centres,
+//! units); docs/detect.md repeats them under "Conventions".
 
+pub mod cubes;
 pub mod doppler;
 pub mod evaluate;
 pub mod images;
+pub mod maps;
 pub mod plots;
 
 use std::path::Path;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{anyhow, Result};
 use faint_core::model::doppler::Window;
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
@@ -28,8 +33,10 @@ use faint_core::Complex32;
 
 use crate::detect::InputKind;
 
+pub use cubes::CubePhysics;
 pub use doppler::{DopplerPhysics, Phase};
 pub use images::ImagePhysics;
+pub use maps::MapPhysics;
 pub use plots::PlotPhysics;
 
 /// Swerling amplitude fluctuation, scan to scan (one draw per frame).
@@ -65,6 +72,10 @@ pub enum Physics {
     Plots(PlotPhysics),
     /// Images.
     Images(ImagePhysics),
+    /// Power cubes.
+    Cubes(CubePhysics),
+    /// Power maps.
+    Maps(MapPhysics),
 }
 
 /// One simulated run.
@@ -105,7 +116,8 @@ impl Physics {
     /// The simulator matching a detector's input kind, with the geometry its
     /// configuration file reads (Doppler: `model.bins`, `model.ts`, `model.window`;
     /// plots: `area`; images: 128 x 128, `noise.as-is.sigma` as the noise std where the
-    /// file states it, else background 1000 and std 20).
+    /// file states it, else background 1000 and std 20; cubes and maps: `geometry`, `dt`
+    /// and the noise power per cell `2 noise_var`; maps also `window`, Hamming if absent).
     pub fn for_detector(kind: InputKind, config: &serde_json::Value) -> Result<Self> {
         let p = match kind {
             InputKind::DopplerFrames => {
@@ -138,8 +150,51 @@ impl Physics {
                     ..ImagePhysics::new(128, 128)
                 })
             }
-            InputKind::PowerCubes | InputKind::PowerMaps => {
-                bail!("{kind:?}: no physics simulator yet (Doppler frames, plots and images only)")
+            InputKind::PowerCubes => {
+                let g = |k: &str| field::<f64>(config, &["geometry", k]);
+                let n = |k: &str| field::<usize>(config, &["geometry", k]);
+                let axis = |nk: &str, sk: &str, ck: &str| -> Result<cubes::Axis> {
+                    Ok(cubes::Axis {
+                        n: n(nk)?,
+                        start: g(sk)?,
+                        size: g(ck)?,
+                    })
+                };
+                Physics::Cubes(CubePhysics {
+                    dt: field(config, &["dt"])?,
+                    noise_power: 2.0 * field::<f64>(config, &["noise_var"])?,
+                    ..CubePhysics::new(
+                        axis("n_range", "range_start", "range_cell")?,
+                        axis("n_doppler", "doppler_start", "doppler_cell")?,
+                        axis("n_azimuth", "azimuth_start_deg", "azimuth_cell_deg")?,
+                    )
+                })
+            }
+            InputKind::PowerMaps => {
+                let g = |k: &str| field::<f64>(config, &["geometry", k]);
+                let n = |k: &str| field::<usize>(config, &["geometry", k]);
+                let window = match config.get("config").and_then(|c| c.get("window")) {
+                    Some(_) => field(config, &["window"])?,
+                    None => Window::Hamming,
+                };
+                let m = MapPhysics::new(
+                    cubes::Axis {
+                        n: n("n_range")?,
+                        start: g("range_start")?,
+                        size: g("range_bin")?,
+                    },
+                    cubes::Axis {
+                        n: n("n_velocity")?,
+                        start: g("velocity_start")?,
+                        size: g("velocity_bin")?,
+                    },
+                );
+                Physics::Maps(MapPhysics {
+                    window,
+                    dt: field(config, &["dt"])?,
+                    noise_power: 2.0 * field::<f64>(config, &["noise_var"])?,
+                    ..m
+                })
             }
         };
         p.validate()?;
@@ -152,6 +207,8 @@ impl Physics {
             Physics::Doppler(p) => p.validate(),
             Physics::Plots(p) => p.validate(),
             Physics::Images(p) => p.validate(),
+            Physics::Cubes(p) => p.validate(),
+            Physics::Maps(p) => p.validate(),
         }
     }
 
@@ -161,24 +218,53 @@ impl Physics {
             Physics::Doppler(_) => &["fd_hz"],
             Physics::Plots(_) => &["x_m", "y_m"],
             Physics::Images(_) => &["x_px", "y_px"],
+            Physics::Cubes(_) => &["x_m", "y_m"],
+            Physics::Maps(_) => &["range_m", "velocity_m_per_s"],
         }
     }
 
-    /// Gate of a correct position (units of the truth columns): one Doppler bin
-    /// `1 / (m ts)` (Hz), 100 m (plots), 2 px (images).
+    /// Gate of a correct position (units of [`Physics::distance`], [`Physics::gate_unit`]):
+    /// one Doppler bin `1 / (m ts)` (Hz), 100 m (plots), 2 px (images), 2 cells (cubes:
+    /// range and azimuth; maps: range and velocity).
     pub fn gate(&self) -> f64 {
         match self {
             Physics::Doppler(p) => 1.0 / (p.bins as f64 * p.ts),
             Physics::Plots(_) => 100.0,
             Physics::Images(_) => 2.0,
+            Physics::Cubes(_) | Physics::Maps(_) => 2.0,
+        }
+    }
+
+    /// The unit of [`Physics::gate`].
+    pub fn gate_unit(&self) -> &'static str {
+        match self {
+            Physics::Doppler(_) => "Hz",
+            Physics::Plots(_) => "m",
+            Physics::Images(_) => "px",
+            Physics::Cubes(_) => "cells (range, azimuth)",
+            Physics::Maps(_) => "cells (range, velocity)",
         }
     }
 
     /// Distance between an estimated position and the truth (Doppler wraps in the band).
+    /// Cubes and maps count cells: `sqrt((dr / range_cell)^2 + (db / azimuth_cell)^2)`
+    /// from the range and azimuth of each `(x, y)` (cubes),
+    /// `sqrt((dr / range_bin)^2 + (dv / velocity_bin)^2)` with `dv` wrapped into
+    /// `[-Va / 2, Va / 2)` (maps).
     pub fn distance(&self, est: &[f64], truth: &[f64]) -> f64 {
         match self {
             Physics::Doppler(p) => match (est.first(), truth.first()) {
                 (Some(&e), Some(&t)) => p.wrap(e - t).abs(),
+                _ => f64::INFINITY,
+            },
+            Physics::Cubes(p) => match (est, truth) {
+                ([ex, ey], [tx, ty]) => p.cell_distance([*ex, *ey], [*tx, *ty]),
+                _ => f64::INFINITY,
+            },
+            Physics::Maps(p) => match (est, truth) {
+                ([er, ev], [tr, tv]) => {
+                    ((er - tr) / p.range.size).hypot(p.wrap(ev - tv) / p.velocity.size)
+                }
                 _ => f64::INFINITY,
             },
             _ => est
@@ -200,6 +286,22 @@ impl Physics {
                 "mean cell SNR of a Swerling-1 target (Pd = pfa^(1/(1+snr)) per scan)"
             }
             Physics::Images(_) => "20 log10(a / sigma), a the spot's total amplitude",
+            Physics::Cubes(_) => {
+                "peak-cell power over noise power a^2 / P, target at a cell centre (the intensity of Pei et al. 2019)"
+            }
+            Physics::Maps(_) => {
+                "peak-pixel SNR a^2 (sum w)^2 / (sigma^2 sum w^2), target at a pixel centre (eq. 19 of the rotor-UAV paper, 2023)"
+            }
+        }
+    }
+
+    /// Shape of one frame of a kind with real frames (`None`: Doppler frames, plots).
+    pub fn frame_shape(&self) -> Option<Vec<usize>> {
+        match self {
+            Physics::Images(p) => Some(vec![p.height, p.width]),
+            Physics::Cubes(p) => Some(vec![p.range.n, p.doppler.n, p.azimuth.n]),
+            Physics::Maps(p) => Some(vec![p.range.n, p.velocity.n]),
+            Physics::Doppler(_) | Physics::Plots(_) => None,
         }
     }
 
@@ -226,6 +328,20 @@ impl Physics {
                 SimRun {
                     data: RunData::Real(f),
                     truth: t.iter().map(|x| x.to_vec()).collect(),
+                }
+            }
+            Physics::Cubes(p) => {
+                let (f, t) = p.simulate(frames, snr_db.map(|s| p.amplitude(s)), rng);
+                SimRun {
+                    data: RunData::Real(f),
+                    truth: t.iter().map(|x| x.position.to_vec()).collect(),
+                }
+            }
+            Physics::Maps(p) => {
+                let (f, t) = p.simulate(frames, snr_db.map(|s| p.amplitude(s)), rng);
+                SimRun {
+                    data: RunData::Real(f),
+                    truth: t.iter().map(|x| vec![x.range, x.velocity]).collect(),
                 }
             }
         }
@@ -255,16 +371,18 @@ impl Physics {
                     .collect();
                 crate::io::output::write_plots(path, &scans)?;
             }
-            Physics::Images(p) => {
+            Physics::Images(_) | Physics::Cubes(_) | Physics::Maps(_) => {
+                let shape = self.frame_shape().unwrap_or_default();
                 let data: Vec<f32> = runs
                     .iter()
                     .flat_map(|r| match &r.data {
-                        RunData::Real(f) => f.clone(),
-                        _ => Vec::new(),
+                        RunData::Real(f) => f.iter().copied(),
+                        _ => [].iter().copied(),
                     })
                     .collect();
-                let k = data.len() / (p.width * p.height).max(1);
-                crate::io::output::write_real_frames(path, &[k, p.height, p.width], &data)?;
+                let k = data.len() / shape.iter().product::<usize>().max(1);
+                let full: Vec<usize> = std::iter::once(k).chain(shape).collect();
+                crate::io::output::write_real_frames(path, &full, &data)?;
             }
         }
         if let Some(tp) = truth {
@@ -278,10 +396,12 @@ impl Physics {
                 first += match &r.data {
                     RunData::Complex(f) => f.len(),
                     RunData::Plots(f) => f.len(),
-                    RunData::Real(f) => match self {
-                        Physics::Images(p) => f.len() / (p.width * p.height).max(1),
-                        _ => 0,
-                    },
+                    RunData::Real(f) => {
+                        f.len()
+                            / self
+                                .frame_shape()
+                                .map_or(1, |s| s.iter().product::<usize>().max(1))
+                    }
                 };
             }
             crate::io::write_text(tp, &text)?;
