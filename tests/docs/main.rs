@@ -172,7 +172,7 @@ fn scratch(root: &Path, doc: &str) -> PathBuf {
     let d = root.join(doc.replace(['/', '.'], "_"));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).expect("scratch folder");
-    for name in ["firmware", "fuzz", "target"] {
+    for name in ["docs", "firmware", "fuzz", "target"] {
         std::os::unix::fs::symlink(repo().join(name), d.join(name)).expect("link");
     }
     d
