@@ -122,7 +122,7 @@ fn chunk3_port<C: MeritCell, const ROT: bool, const M: usize>(
 }
 
 /// [`chunk3_port`] (the assembly is the Cortex-M4's).
-#[cfg(not(target_arch = "arm"))]
+#[cfg(not(faint_m4_asm))]
 #[inline(always)]
 fn chunk3<C: MeritCell, const ROT: bool, const M: usize>(
     c: &[i32; 32],
@@ -138,7 +138,7 @@ fn chunk3<C: MeritCell, const ROT: bool, const M: usize>(
 /// as [`chunk3_port`]: `zs`, `os` from the chunk's first pixel of row `y` (row `y + 1` at `+ M`),
 /// `best` two halfword maxima (`ssub16`/`sel`); returns the two rows' back-pointer words.
 /// `vcvtr` rounds to nearest even in the default FPSCR mode, as [`round_q`].
-#[cfg(target_arch = "arm")]
+#[cfg(faint_m4_asm)]
 #[allow(unsafe_code)]
 #[inline(always)]
 fn chunk3<C: MeritCell, const ROT: bool, const M: usize>(
@@ -285,7 +285,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     const LP: usize = L.saturating_sub(1);
     /// Whether the 3x3 column pass runs as Cortex-M4 assembly (`chunk3`; its offsets
     /// need `M <= 255`).
-    const ASM3: bool = cfg!(target_arch = "arm") && M <= 255;
+    const ASM3: bool = cfg!(faint_m4_asm) && M <= 255;
     const SHAPE: () = assert!(
         W == Self::LP * Self::WF,
         "W must be dp::arnold_words(M, QB, L)"

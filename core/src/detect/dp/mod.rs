@@ -652,14 +652,14 @@ impl<'a> BitWriter<'a> {
     /// For a writer outside (the second order's Cortex-M4 `J` row): the unwritten
     /// words, the pending bits and their count; [`Self::skip`] then counts the words
     /// it wrote.
-    #[cfg_attr(not(target_arch = "arm"), allow(dead_code))]
+    #[cfg_attr(not(faint_m4_asm), allow(dead_code))]
     pub(crate) fn parts(&mut self) -> (&mut [u32], &mut u32, &mut u32) {
         let words = self.words.get_mut(self.next..).unwrap_or(&mut []);
         (words, &mut self.acc, &mut self.fill)
     }
 
     /// `n` more words written (see [`Self::parts`]).
-    #[cfg_attr(not(target_arch = "arm"), allow(dead_code))]
+    #[cfg_attr(not(faint_m4_asm), allow(dead_code))]
     pub(crate) fn skip(&mut self, n: usize) {
         self.next += n;
     }

@@ -196,7 +196,7 @@ pub(crate) const fn layout(qb: usize) -> Layout {
 /// Pointer-code tables of the Cortex-M4 `J` row ([`j_row_asm`], `q_B = 9`): the code is
 /// the sum of `jterm[d][c_d]` over the states, looked up as `jterm[8]` (16 words) and the
 /// pairs `(0, 1)`, `(3, 4)`, `(6, 7)`, `(2, 5)` (256 words each, index `c_a | c_b << 4`).
-#[cfg_attr(not(target_arch = "arm"), allow(dead_code))]
+#[cfg_attr(not(faint_m4_asm), allow(dead_code))]
 static ATAB: [u32; 16 + 4 * 256] = atab();
 
 const fn atab() -> [u32; 16 + 4 * 256] {
@@ -230,7 +230,7 @@ const fn atab() -> [u32; 16 + 4 * 256] {
 /// writer lacks the words the row completes.
 /// Registers: `r0` source, `r1` ring cell `3 x`, `r2`-`r7` `GX`, `GY`, `r8`-`r10`
 /// `Hx` then keys, `r11`, `r12` scratch, `lr` the nibbles of states 0, 1, 3, 4, 6, 7.
-#[cfg(target_arch = "arm")]
+#[cfg(faint_m4_asm)]
 #[allow(unsafe_code)]
 #[inline(always)]
 fn j_row_asm<C: MeritCell, const QB: usize, const M: usize, const ROT: usize>(
@@ -414,7 +414,7 @@ fn j_row_asm<C: MeritCell, const QB: usize, const M: usize, const ROT: usize>(
 /// (`ssub16`/`sel`); returns it. `i16`: `qadd16` (exact when every `zq` is an `i16`,
 /// `q16` true; else `None`); `i8`: `qadd8`, four states per register, when every `zq`
 /// is an `i8` (`q16` true), else `sxtb16`, `sadd16`, `ssat16 #8` (always exact).
-#[cfg(target_arch = "arm")]
+#[cfg(faint_m4_asm)]
 #[allow(unsafe_code)]
 #[inline(always)]
 fn scatter_asm<C: MeritCell, const QB: usize, const M: usize>(
@@ -585,7 +585,7 @@ fn scatter_asm<C: MeritCell, const QB: usize, const M: usize>(
 
 /// Byte offset, from ring cell `3 x`, of state `s = 3 (dy + 1) + dx + 1` of source pixel
 /// `x` in row `rr` (`rr mod 3 = ROT`): cell `3 (x + dx + 1) + (rr + dy) mod 3`.
-#[cfg(target_arch = "arm")]
+#[cfg(faint_m4_asm)]
 const fn off<const ROT: usize>(s: usize, sz: usize) -> usize {
     let (dyi, dxi) = (s / 3, s % 3);
     ((3 * dxi + (ROT + dyi + 2) % 3) * 9 + s) * sz
@@ -881,7 +881,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         if ring.len() < 3 * (M + 2) || QB != 9 {
             return;
         }
-        #[cfg(target_arch = "arm")]
+        #[cfg(faint_m4_asm)]
         if let Some(w) = bw.as_mut() {
             let done = match rr % 3 {
                 0 => j_row_asm::<C, QB, M, 0>(src, ring, gk, w),
@@ -970,7 +970,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         let mut clamped = 0;
         let (mut best, mut bxy) = (i32::MIN, (0u16, 0u16));
         // every zq = round(z / lsb) - sub, |round(z / lsb)| <= ZMAX, is a cell value
-        #[cfg(target_arch = "arm")]
+        #[cfg(faint_m4_asm)]
         let q16 = {
             let cmax = C::sat(i32::MAX).get();
             sub >= C::ZMAX - cmax && sub <= cmax + 1 - C::ZMAX
@@ -992,9 +992,9 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 continue;
             };
             let cells = ring.get(3 + sl..).unwrap_or(&[]);
-            #[cfg(target_arch = "arm")]
+            #[cfg(faint_m4_asm)]
             let asm_rb = scatter_asm::<C, QB, M>(cells, row, zrow, q16);
-            #[cfg(not(target_arch = "arm"))]
+            #[cfg(not(faint_m4_asm))]
             let asm_rb: Option<i32> = None;
             let (rb, rx) = match asm_rb {
                 // (the pixel only when the frame's best rises: the first holding it)
