@@ -101,6 +101,11 @@ fn run_by_ci(command: &str, ci: &str) -> bool {
     // The command as a whole shell word sequence of a `.ci/run` line: at its end, or
     // before a `)`, a redirection, a pipe or a continuation.
     let ends = [")", " >", " 2>", " |", " \\", " &&"];
+    // A shell keyword closing a loop or a branch (`done`, `fi`) is part of its block's
+    // script, never a command of its own (`.ci/run` has such lines too).
+    if matches!(n.trim(), "done" | "fi" | "esac" | "else" | "then" | "do" | "}") {
+        return false;
+    }
     after_env == ".ci/run"
         || ci.lines().any(|l| {
             l.match_indices(n.as_str()).any(|(i, _)| {
