@@ -103,7 +103,10 @@ fn run_by_ci(command: &str, ci: &str) -> bool {
     let ends = [")", " >", " 2>", " |", " \\", " &&"];
     // A shell keyword closing a loop or a branch (`done`, `fi`) is part of its block's
     // script, never a command of its own (`.ci/run` has such lines too).
-    if matches!(n.trim(), "done" | "fi" | "esac" | "else" | "then" | "do" | "}") {
+    if matches!(
+        n.trim(),
+        "done" | "fi" | "esac" | "else" | "then" | "do" | "}"
+    ) {
         return false;
     }
     after_env == ".ci/run"
