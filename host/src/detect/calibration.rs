@@ -146,6 +146,15 @@ impl Calibration {
         Some(total as f64 / (counts.len() as f64 * self.runs as f64))
     }
 
+    /// How many of the noise runs exceeded frame `k`'s threshold (`None` for a frame
+    /// without a threshold or a file of an older build).
+    pub fn exceedances_at(&self, k: usize) -> Option<usize> {
+        self.thresholds
+            .iter()
+            .find(|t| t.frame == k)
+            .and_then(|t| t.exceedances)
+    }
+
     /// Reads and checks `path`.
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)

@@ -98,6 +98,14 @@ pub fn window_coefficient(window: Window, n: usize, m: usize) -> f64 {
     }
 }
 
+/// `sum w` and `sum w^2` of an `m`-point window ([`window_coefficient`]).
+pub fn window_sums(window: Window, m: usize) -> (f64, f64) {
+    (0..m).fold((0.0, 0.0), |(s, s2), n| {
+        let w = window_coefficient(window, n, m);
+        (s + w, s2 + w * w)
+    })
+}
+
 /// One simulated target's state at a frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DopplerTruth {
@@ -162,10 +170,7 @@ impl DopplerPhysics {
 
     /// `sum w` and `sum w^2` of the window.
     pub fn window_sums(&self) -> (f64, f64) {
-        (0..self.bins).fold((0.0, 0.0), |(s, s2), n| {
-            let w = window_coefficient(self.window, n, self.bins);
-            (s + w, s2 + w * w)
-        })
+        window_sums(self.window, self.bins)
     }
 
     /// Processing gain `G = (sum w)^2 / sum w^2`.

@@ -55,10 +55,7 @@ pub fn calibration_prediction(
     let n = cal.runs;
     let r = ((n as f64) * (1.0 - pfa)).ceil() as usize;
     let e = cal
-        .thresholds
-        .iter()
-        .find(|t| t.frame == k)
-        .and_then(|t| t.exceedances)
+        .exceedances_at(k)
         .unwrap_or(n.saturating_sub(r))
         .min(n.saturating_sub(1));
     let (a, b) = ((e + 1) as f64, (n - e) as f64);
@@ -389,10 +386,7 @@ pub fn run(a: &Args) -> Result<Evaluation> {
     })?;
     let (interval, predicted) = calibration_prediction(&cal, l - 1, a.pfa, a.runs)?;
     let pfa_achieved = cal
-        .thresholds
-        .iter()
-        .find(|t| t.frame == l - 1)
-        .and_then(|t| t.exceedances)
+        .exceedances_at(l - 1)
         .map_or(a.pfa, |e| e as f64 / cal.runs.max(1) as f64);
 
     // 2. False alarms on fresh noise.

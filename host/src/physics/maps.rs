@@ -51,7 +51,7 @@ use rustfft::num_complex::Complex64;
 use rustfft::FftPlanner;
 
 use super::cubes::{sinc, Axis, REACH};
-use super::doppler::window_coefficient;
+use super::doppler::{window_coefficient, window_sums};
 use super::Swerling;
 
 /// The power-map simulator's parameters.
@@ -168,11 +168,7 @@ impl MapPhysics {
 
     /// `sum w` and `sum w^2` of the window over the `Nv` pulses.
     pub fn window_sums(&self) -> (f64, f64) {
-        let m = self.velocity.n;
-        (0..m).fold((0.0, 0.0), |(s, s2), n| {
-            let w = window_coefficient(self.window, n, m);
-            (s + w, s2 + w * w)
-        })
+        window_sums(self.window, self.velocity.n)
     }
 
     /// Amplitude `a` of the peak SNR `snr_db`: `a = sqrt(SNR P) / sum w`.

@@ -102,12 +102,7 @@ impl Projection {
     /// logarithm is finite (an exact fit or an all-zero frame).
     #[inline]
     pub fn residual_norm2(&self, zz: f32) -> f32 {
-        let d = zz - 2.0 * self.zh.re + self.hh;
-        if d > f32::MIN_POSITIVE {
-            d
-        } else {
-            f32::MIN_POSITIVE
-        }
+        floored(zz - 2.0 * self.zh.re + self.hh)
     }
 
     /// Gaussian log likelihood ratio `ln p(z|x)/p(z|0) = (2 Re<z,h> - ||h||^2) / s2` for
@@ -122,12 +117,7 @@ impl Projection {
     /// a full projection).
     #[inline]
     pub fn residual_norm2_unknown_phase(&self, zz: f32) -> f32 {
-        let d = zz - 2.0 * math::hypot(self.zh.re, self.zh.im) + self.hh;
-        if d > f32::MIN_POSITIVE {
-            d
-        } else {
-            f32::MIN_POSITIVE
-        }
+        floored(zz - 2.0 * math::hypot(self.zh.re, self.zh.im) + self.hh)
     }
 
     /// The log likelihood ratio averaged over a uniform phase (Rician):
@@ -161,6 +151,17 @@ impl Projection {
             Phase::Zero => self.log_lr(inv_var),
             Phase::Unknown => self.log_lr_unknown_phase(inv_var),
         }
+    }
+}
+
+/// A squared residual floored at `f32::MIN_POSITIVE`, so its logarithm is finite (NaN
+/// becomes the floor too).
+#[inline(always)]
+fn floored(d: f32) -> f32 {
+    if d > f32::MIN_POSITIVE {
+        d
+    } else {
+        f32::MIN_POSITIVE
     }
 }
 
