@@ -21,7 +21,7 @@ use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint_core::detect::Detector;
-use faint_core::model::doppler::{DopplerModel, DopplerReport, Phase, Window};
+use faint_core::model::doppler::{DopplerModel, DopplerReport, Likelihood, Phase, Window};
 use faint_core::rng::Rng;
 use faint_core::Complex32;
 use faint_golden::crpf::{frame, target, BIN_VAR};
@@ -181,6 +181,17 @@ fn rows<const N: usize>(
         check(pf.configure(&unknown, SEED));
         measure_one(
             "PF-TBD step, phase unknown (32 bins)",
+            n,
+            &mut |z| pf.step(z),
+            model,
+            size_of::<PfTbd<N>>(),
+        );
+        // `faint detect`'s default: the Rician log-LR on frames whitened in the step
+        // (the window-aware likelihood: m^2 = 1024 complex multiply-adds per frame).
+        unknown.likelihood = Likelihood::Window;
+        check(pf.configure(&unknown, SEED));
+        measure_one(
+            "PF-TBD step, phase unknown, window likelihood (32 bins)",
             n,
             &mut |z| pf.step(z),
             model,

@@ -25,6 +25,8 @@ fn quick_reproduction_writes_every_output() {
         comparator_var: Default::default(),
         comparator_likelihood: Default::default(),
         window: Default::default(),
+        phase: Default::default(),
+        echo_phase: Default::default(),
         birth_proposal: "exact".into(),
         quick: true,
     };

@@ -3,7 +3,8 @@
 //! flag + 4 B log weight + 4 B weight + 4 B ancestor), PF-TBD 28 B (16 + 12), JOTT and PF-LRT 24 B (12 + 12), plus a
 //! fixed part under 11 KB (the response table as 128 interpolation rows of 5 bins x 4
 //! f32, 10 KB) besides the tables of the cached projection (3.5 KB per model at the
-//! 512-bin capacity, and CRPF-TBD's 20 KB cache and 4 KB previous frame).
+//! 512-bin capacity, CRPF-TBD's 20 KB cache and 4 KB previous frame, the comparators'
+//! 8 KB whitener).
 
 use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::CrpfTbd;
@@ -21,7 +22,9 @@ fn check(name: &str, n: usize, size: usize, per: usize) {
         + if name == "CRPF-TBD" {
             1024 * 20 + 4 + 8 * MAX_BINS
         } else {
-            0
+            // The comparators' whitener (window-aware likelihood): kernel and whitened
+            // frame, MAX_BINS complex bins each, and its bin count.
+            2 * 8 * MAX_BINS + 8
         };
     let fixed = size as isize - (per * n) as isize - cache as isize;
     println!("{name:9} N = {n:5}: {size:7} B ({per} B/particle + {fixed} B)");

@@ -147,6 +147,7 @@ fn doppler_detectors_round_trip() {
         model: ModelConfig::othr(),
         noise_var: var,
         birth: Default::default(),
+        likelihood: Default::default(),
     };
     let want_crpf = doppler_rows(
         &run_detector(

@@ -11,12 +11,16 @@
 //! estimate:  sum_i w_i x_i / sum_i w_i over the particles holding a target (band wrap)
 //! resample:  systematic, then gather in place
 //! ```
-//! Noise model: independent complex Gaussian bins of variance `s2` ([`GaussConfig`]).
+//! Noise model: independent complex Gaussian bins of variance `s2` ([`GaussConfig`]), or
+//! with [`Likelihood::Window`] the window's correlated bins: each frame whitened first
+//! (`z' = F W^-1 F^-1 z`, [`Whitener`]), the rectangular window's response `h'` and the
+//! per-bin variance `m s2 / sum w^2` in the formulas above.
 
 use crate::detect::Validate;
 use crate::math;
 use crate::model::doppler::{
-    check_frame, DopplerModel, DopplerReport, Model, ModelConfig, Motion, Phase,
+    check_frame, DopplerModel, DopplerReport, Likelihood, Model, ModelConfig, Motion, Phase,
+    Whitener, Window,
 };
 use crate::particles::{gather_in_place, resample, Scheme};
 use crate::rng::Rng;
@@ -97,6 +101,12 @@ pub struct GaussConfig {
     /// configurations means [`BirthProposal::Exact`].
     #[cfg_attr(feature = "serde", serde(default))]
     pub birth: BirthProposal,
+    /// The bins' noise model ([`Likelihood`]): `independent` (Lu, Wang, Zhang 2017; the
+    /// presets) or `window` (the window's bin covariance, exact for windowed frames;
+    /// `faint detect`'s default). Absent in serialised configurations means
+    /// `independent`, the model of every file written before the option existed.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub likelihood: Likelihood,
 }
 
 impl GaussConfig {
@@ -106,6 +116,50 @@ impl GaussConfig {
             model: ModelConfig::othr(),
             noise_var,
             birth: BirthProposal::Exact,
+            likelihood: Likelihood::Independent,
+        }
+    }
+
+    /// Whether frames are whitened: [`Likelihood::Window`] with a window that is not
+    /// rectangular (for the rectangular window the two likelihoods coincide).
+    pub fn whitens(&self) -> bool {
+        self.likelihood == Likelihood::Window && self.model.window != Window::Rectangular
+    }
+
+    /// The model the particles are weighed with: the configured one, with the
+    /// rectangular window's response when frames are whitened.
+    fn weighing_model(&self) -> ModelConfig {
+        let mut m = self.model;
+        if self.whitens() {
+            m.window = Window::Rectangular;
+        }
+        m
+    }
+
+    /// `1 / s2` of the bins the particles are weighed against: `1 / noise_var`, or for
+    /// whitened frames `sum w^2 / (m noise_var)` (`noise_var` is the windowed bins'
+    /// variance `s2t sum w^2`, a whitened bin's is `m s2t`). Errors
+    /// ([`Error::InvalidConfig`]) as [`check_variance`], or an inverse that is not finite
+    /// and positive.
+    fn weighing_inv_var(&self, v: f32) -> Result<f32> {
+        let inv = check_variance(v)?;
+        if !self.whitens() {
+            return Ok(inv);
+        }
+        let m = self.model.bins.max(1);
+        let e: f64 = (0..m)
+            .map(|n| {
+                let w = self.model.window.coefficient(n, m);
+                w * w
+            })
+            .sum();
+        let r = (f64::from(inv) * e / m as f64) as f32;
+        if r.is_finite() && r > 0.0 {
+            Ok(r)
+        } else {
+            Err(Error::InvalidConfig(
+                "noise variance must be finite and > 0",
+            ))
         }
     }
 
@@ -118,11 +172,12 @@ impl GaussConfig {
     /// ([`ModelConfig::build_reusing`](crate::model::doppler::ModelConfig::build_reusing)).
     fn build_reusing(&self, old: Option<&DopplerModel>) -> Result<Model> {
         check_variance(self.noise_var)?;
-        self.model.build_reusing(old)
+        self.weighing_model().build_reusing(old)
     }
 
     /// What every Gaussian comparator's `new` / `configure` needs: `N > 0`, a valid birth
-    /// proposal for `N`, the built model (reusing `old`'s table when it fits) and `1 / s2`.
+    /// proposal for `N`, the built weighing model (reusing `old`'s table when it fits) and
+    /// the weighing `1 / s2`.
     pub(crate) fn prepare<const N: usize>(
         &self,
         old: Option<&DopplerModel>,
@@ -132,13 +187,15 @@ impl GaussConfig {
         }
         self.birth.birth_count::<N>()?;
         let model = self.build_reusing(old)?;
-        Ok((model, 1.0 / self.noise_var))
+        Ok((model, self.weighing_inv_var(self.noise_var)?))
     }
 }
 
 impl Validate for GaussConfig {
     fn validate(&self) -> Result<()> {
-        self.build().map(|_| ())
+        self.build()?;
+        self.weighing_inv_var(self.noise_var)?;
+        Whitener::inactive().configure(self.likelihood, self.model.window, self.model.bins)
     }
 }
 
@@ -247,13 +304,26 @@ pub(crate) struct GaussianCloud<P, const N: usize> {
     w: [f32; N],
     anc: [u32; N],
     last: DopplerReport,
+    white: Whitener,
+}
+
+/// The fields a frame's weighing loop borrows (the frame may borrow the whitener).
+struct Weigh<'a, P, const N: usize> {
+    model: &'a Model,
+    inv_var: f32,
+    rng: &'a mut Rng,
+    parts: &'a mut [P; N],
+    log_w: &'a mut [f32; N],
 }
 
 impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
     /// Validates `cfg`; particles are default until [`reset`](Self::reset).
     pub(crate) fn new(cfg: GaussConfig) -> Result<Self> {
         let (model, inv_var) = cfg.prepare::<N>(None)?;
+        let mut white = Whitener::inactive();
+        white.configure(cfg.likelihood, cfg.model.window, cfg.model.bins)?;
         Ok(Self {
+            white,
             cfg,
             model,
             inv_var,
@@ -271,15 +341,18 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
     /// [`reset`](Self::reset)s next.
     pub(crate) fn reconfigure(&mut self, cfg: GaussConfig) -> Result<()> {
         let (model, inv_var) = cfg.prepare::<N>(Some(&self.model.obs))?;
+        // Validates before it writes: on error nothing has changed.
+        self.white
+            .configure(cfg.likelihood, cfg.model.window, cfg.model.bins)?;
         self.cfg = cfg;
         self.model = model;
         self.inv_var = inv_var;
         Ok(())
     }
 
-    /// Sets the assumed per-bin noise variance.
+    /// Sets the assumed per-bin noise variance of the (windowed) frames.
     pub(crate) fn set_noise_variance(&mut self, v: f32) -> Result<()> {
-        self.inv_var = check_variance(v)?;
+        self.inv_var = self.cfg.weighing_inv_var(v)?;
         self.cfg.noise_var = v;
         Ok(())
     }
@@ -322,28 +395,49 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
         z: &[Complex32],
         mut step: impl FnMut(&mut P, &Model, &mut Rng),
     ) -> Result<()> {
-        check_frame(z, self.model.obs.bins())?;
+        let (z, w) = self.frame_and_loop(z)?;
         // The phase model as a constant of the loop (one copy per model).
-        match self.model.phase {
-            Phase::Zero => self.weigh_all::<false>(z, &mut step),
-            Phase::Unknown => self.weigh_all::<true>(z, &mut step),
+        match w.model.phase {
+            Phase::Zero => Self::weigh_all::<false>(w, z, &mut step),
+            Phase::Unknown => Self::weigh_all::<true>(w, z, &mut step),
         }
         Ok(())
+    }
+
+    /// Checks the frame ([`check_frame`]), whitens it when the likelihood says so
+    /// ([`Whitener::apply`]); returns it with the weighing loop's fields. On error nothing
+    /// but the whitener's scratch frame has changed.
+    fn frame_and_loop<'a>(
+        &'a mut self,
+        z: &'a [Complex32],
+    ) -> Result<(&'a [Complex32], Weigh<'a, P, N>)> {
+        check_frame(z, self.model.obs.bins())?;
+        let z = self.white.apply(z)?;
+        Ok((
+            z,
+            Weigh {
+                model: &self.model,
+                inv_var: self.inv_var,
+                rng: &mut self.rng,
+                parts: &mut self.parts,
+                log_w: &mut self.log_w,
+            },
+        ))
     }
 
     /// The loop of [`predict_and_weigh`](Self::predict_and_weigh) for the phase model `U`
     /// (its own function: the detectors' step stays the size it was).
     #[inline(never)]
     fn weigh_all<const U: bool>(
-        &mut self,
+        w: Weigh<'_, P, N>,
         z: &[Complex32],
         step: &mut impl FnMut(&mut P, &Model, &mut Rng),
     ) {
-        let m = &self.model;
-        for (p, lw) in self.parts.iter_mut().zip(self.log_w.iter_mut()) {
-            step(p, m, &mut self.rng);
+        let m = w.model;
+        for (p, lw) in w.parts.iter_mut().zip(w.log_w.iter_mut()) {
+            step(p, m, w.rng);
             *lw = match p.target() {
-                Some(x) => log_lr_of::<U>(m, z, x, self.inv_var),
+                Some(x) => log_lr_of::<U>(m, z, x, w.inv_var),
                 None => 0.0,
             };
         }
@@ -364,10 +458,10 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
         births: u32,
         mut step: impl FnMut(&mut P, bool, &Model, &mut Rng) -> f32,
     ) -> Result<()> {
-        check_frame(z, self.model.obs.bins())?;
-        match self.model.phase {
-            Phase::Zero => self.weigh_split::<false>(z, births, &mut step),
-            Phase::Unknown => self.weigh_split::<true>(z, births, &mut step),
+        let (z, w) = self.frame_and_loop(z)?;
+        match w.model.phase {
+            Phase::Zero => Self::weigh_split::<false>(w, z, births, &mut step),
+            Phase::Unknown => Self::weigh_split::<true>(w, z, births, &mut step),
         }
         Ok(())
     }
@@ -376,25 +470,25 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
     /// phase model `U` (its own function, as `weigh_all`).
     #[inline(never)]
     fn weigh_split<const U: bool>(
-        &mut self,
+        w: Weigh<'_, P, N>,
         z: &[Complex32],
         births: u32,
         step: &mut impl FnMut(&mut P, bool, &Model, &mut Rng) -> f32,
     ) {
-        let m = &self.model;
+        let m = w.model;
         // 2 <= N <= 2^31 and births < N (birth_count): acc + births < 2^32, and acc stays
         // below N after each step.
         let n = N as u32;
-        let mut acc = self.rng.below(n);
-        for (p, lw) in self.parts.iter_mut().zip(self.log_w.iter_mut()) {
+        let mut acc = w.rng.below(n);
+        for (p, lw) in w.parts.iter_mut().zip(w.log_w.iter_mut()) {
             acc += births;
             let birth_slot = acc >= n;
             if birth_slot {
                 acc -= n;
             }
-            let prior = step(p, birth_slot, m, &mut self.rng);
+            let prior = step(p, birth_slot, m, w.rng);
             *lw = match p.target() {
-                Some(x) => prior + log_lr_of::<U>(m, z, x, self.inv_var),
+                Some(x) => prior + log_lr_of::<U>(m, z, x, w.inv_var),
                 None => prior,
             };
         }

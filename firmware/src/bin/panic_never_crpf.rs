@@ -33,8 +33,8 @@ use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd};
 use faint_core::detect::{run as run_frames, Detector, Validate};
 use faint_core::model::doppler::{
-    check_frame, dtft, estimate_noise_variance, max_amplitude, unwindow, DopplerModel, ModelConfig,
-    Phase, ProjectionCache, Window, MAX_BINS, SPAN,
+    check_frame, dtft, estimate_noise_variance, max_amplitude, unwindow, DopplerModel, Likelihood,
+    ModelConfig, Phase, ProjectionCache, Window, MAX_BINS, SPAN,
 };
 use faint_core::rng::Rng;
 use faint_core::Complex32;
@@ -323,6 +323,12 @@ fn family<const N: usize>(
         model: rect,
         noise_var: black_box(M as f32) * black_box(1.0),
         birth: Default::default(),
+        likelihood: Default::default(),
+    };
+    // The window-aware likelihood on the detector's path (frames whitened in the step).
+    let aware = GaussConfig {
+        likelihood: black_box(Likelihood::Window),
+        ..ham
     };
     let shared = GaussConfig {
         birth: BirthProposal::FixedShare(black_box(0.1)),
@@ -340,6 +346,7 @@ fn family<const N: usize>(
         (white, &model_r, Some(Window::Hamming)),
         (shared, &model_h, None),
         (unknown, &model_h, None),
+        (aware, &model_h, None),
     ] {
         ok &= pf.configure(&cfg, black_box(1)).is_ok();
         ok &= exercise(pf, model, whiten, rng);

@@ -6,7 +6,7 @@ use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint_core::detect::Detector;
-use faint_core::model::doppler::{ModelConfig, Phase, Window};
+use faint_core::model::doppler::{Likelihood, ModelConfig, Phase, Window};
 use faint_core::Complex32;
 use serde::{Deserialize, Serialize};
 
@@ -85,10 +85,13 @@ pub(super) fn default_crpf() -> String {
     json(&doppler_defaults(1000, c, &c.model))
 }
 
-/// The Gaussian comparators' default configuration file: as [`default_crpf`].
+/// The Gaussian comparators' default configuration file: as [`default_crpf`], with the
+/// window-aware likelihood (the preset's Hamming bins are correlated; the paper's
+/// independent-bin likelihood is the reproduction's).
 pub(super) fn default_gauss() -> String {
     let mut c = GaussConfig::othr(1.0);
     c.model.phase = Phase::Unknown;
+    c.likelihood = Likelihood::Window;
     json(&doppler_defaults(1000, c, &c.model))
 }
 

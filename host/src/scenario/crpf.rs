@@ -9,7 +9,9 @@
 //!   rate 0.13 Hz/s per frame by noise, against a bin width of 1/dT = 1.5625 Hz).
 //! - Target present in frames 7..=26 (1-based). At frame 7: `fd ~ U[-25, 25)` Hz (the
 //!   whole unambiguous band, choice), `fda ~ U(-0.5, 0.5)` Hz/s (paper), amplitude from
-//!   the SNR; phase 0 at the start of every frame (paper: `phi_k = 0`).
+//!   the SNR; phase 0 at the start of every frame (paper: `phi_k = 0`), or with
+//!   `random_phase` uniform in `[0, 2 pi)` and independent per frame (independent
+//!   dwells; not the paper's).
 //! - Observation eq. 17: `z_k = DFT_W(A exp(j 2 pi fd n ts) + wbar_k)`, Hamming window
 //!   (choice), `z_b = sum_n w_n s_n exp(-j 2 pi b n / m)`. Noise is added in time,
 //!   white, with unit variance `E|wbar_n|^2 = 1`, so the bins are correlated and each has
@@ -67,6 +69,9 @@ pub struct Othr {
     pub cgg_shape: f64,
     /// Analysis window (the preset: Hamming).
     pub window: Window,
+    /// The target's phase at each frame's start uniform and independent per frame
+    /// (`false`, the preset: zero, eq. 17).
+    pub random_phase: bool,
 }
 
 impl Default for Othr {
@@ -84,6 +89,7 @@ impl Default for Othr {
             noise_var: 1.0,
             cgg_shape: 0.1,
             window: Window::Hamming,
+            random_phase: false,
         }
     }
 }
@@ -172,8 +178,15 @@ impl Othr {
             }
             let tr = if present { state } else { None };
             if let Some(x) = tr {
+                // One draw per frame with a target, only for a random phase (the preset's
+                // streams are unchanged).
+                let phi0 = if self.random_phase {
+                    2.0 * std::f64::consts::PI * uniform64(rng)
+                } else {
+                    0.0
+                };
                 for (n, t) in time.iter_mut().enumerate() {
-                    let ph = 2.0 * std::f64::consts::PI * x[0] * n as f64 * self.ts;
+                    let ph = phi0 + 2.0 * std::f64::consts::PI * x[0] * n as f64 * self.ts;
                     t.0 += x[2] * ph.cos();
                     t.1 += x[2] * ph.sin();
                 }

@@ -59,7 +59,7 @@ pub use response::{
     dtft, DopplerModel, Phase, Projection, Window, HALF_SPAN, MAX_BINS, RESPONSE_ERROR_BOUND, SPAN,
     TABLE_STEPS,
 };
-pub use whiten::unwindow;
+pub use whiten::{unwindow, Likelihood, Whitener, MIN_WINDOW_COEFFICIENT};
 
 use crate::{Complex32, Error, Result};
 

@@ -73,3 +73,153 @@ pub fn unwindow(z: &mut [Complex32], window: Window) -> Result<()> {
     }
     Ok(())
 }
+
+/// The Gaussian comparators' noise model of the bins (PF-TBD, JOTT, PF-LRT;
+/// [`GaussConfig::likelihood`](crate::detect::pf_tbd::GaussConfig::likelihood)).
+///
+/// ```text
+/// Independent: ln LR = (2 Re<z,h> - ||h||^2) / s2          bins of the windowed frame
+///                                                           taken as independent
+/// Window:      ln LR = (2 Re<z',h'> - ||h'||^2) / (m s2t)   z' = F W^-1 F^-1 z (module
+///                                                           doc), h' the rectangular
+///                                                           response, s2t = s2 / sum w^2
+/// ```
+/// `Window` is the exact Gaussian likelihood ratio of the bins `h'` spans under the
+/// window's bin covariance; `Independent` is the approximation of Lu, Wang, Zhang (2017)
+/// (exact only for a rectangular window, where the two coincide).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "kebab-case")
+)]
+pub enum Likelihood {
+    /// Independent bins of the windowed frame: the paper's model and the presets'. The
+    /// default, and what a configuration without the key means (the model of every file
+    /// written before the option existed).
+    #[default]
+    Independent,
+    /// The window's bin covariance taken into account: each frame whitened on the
+    /// detector's path by [`Whitener`] (`m^2` complex multiply-adds per frame), the
+    /// rectangular window's response. Needs every window coefficient `>= 1e-6` (not the
+    /// symmetric Hann window, whose end points are zero).
+    Window,
+}
+
+/// Smallest window coefficient [`Whitener`] accepts: `1 / w` must stay finite and the
+/// whitened frame's energy within `f32` (module doc).
+pub const MIN_WINDOW_COEFFICIENT: f64 = 1e-6;
+
+/// The whitening operator of [`unwindow`] as a circulant kernel in the bin domain, and
+/// the whitened frame:
+///
+/// ```text
+/// z'_b = sum_k c_((b - k) mod m) z_k,   c_d = (1/m) sum_n (1/w_n) exp(-j 2 pi d n / m)
+/// ```
+///
+/// (`F W^-1 F^-1` is diagonal in time, so circulant in frequency). The kernel is computed
+/// once in `f64` and stored in `f32`; a frame costs `m^2` complex multiply-adds in `f32`
+/// (`m = 32`: 1 024). Inactive (the frame passes through unchanged) for the independent
+/// likelihood or a rectangular window, where `z' = z`.
+#[derive(Debug, Clone)]
+pub struct Whitener {
+    /// Bins `m`; 0 when inactive.
+    m: usize,
+    kernel: [Complex32; MAX_BINS],
+    out: [Complex32; MAX_BINS],
+}
+
+impl Whitener {
+    /// An inactive whitener (every frame passes through).
+    pub const fn inactive() -> Self {
+        Self {
+            m: 0,
+            kernel: [Complex32::new(0.0, 0.0); MAX_BINS],
+            out: [Complex32::new(0.0, 0.0); MAX_BINS],
+        }
+    }
+
+    /// Builds the kernel for `likelihood` with an `m`-point `window` (inactive for
+    /// [`Likelihood::Independent`] or [`Window::Rectangular`]). Errors
+    /// ([`Error::InvalidConfig`]), before any change: `m` outside `1..=MAX_BINS`, a window
+    /// coefficient below [`MIN_WINDOW_COEFFICIENT`].
+    pub fn configure(&mut self, likelihood: Likelihood, window: Window, m: usize) -> Result<()> {
+        if !(1..=MAX_BINS).contains(&m) {
+            return Err(Error::InvalidConfig("bins per frame (1..=512)"));
+        }
+        if likelihood == Likelihood::Independent || window == Window::Rectangular {
+            self.m = 0;
+            return Ok(());
+        }
+        let mut inv_w = [0.0f64; MAX_BINS];
+        for (n, iw) in inv_w.iter_mut().enumerate().take(m) {
+            let w = window.coefficient(n, m);
+            if !(w.is_finite() && w >= MIN_WINDOW_COEFFICIENT) {
+                return Err(Error::InvalidConfig(
+                    "likelihood window: the window has a zero coefficient",
+                ));
+            }
+            *iw = 1.0 / w;
+        }
+        for (d, c) in self.kernel.iter_mut().enumerate().take(m) {
+            let (mut re, mut im) = (0.0f64, 0.0f64);
+            for (n, &iw) in inv_w.iter().enumerate().take(m) {
+                // (d n) mod m keeps the angle in [0, 2 pi): the same twiddles at any m.
+                let ph = -2.0 * core::f64::consts::PI * ((d * n) % m) as f64 / m as f64;
+                re += iw * libm::cos(ph);
+                im += iw * libm::sin(ph);
+            }
+            *c = Complex32::new((re / m as f64) as f32, (im / m as f64) as f32);
+        }
+        self.m = m;
+        Ok(())
+    }
+
+    /// Whether frames are whitened.
+    pub fn is_active(&self) -> bool {
+        self.m > 0
+    }
+
+    /// `z'` of a frame already checked by [`check_frame`] for this whitener's `m` bins:
+    /// the whitened frame, or `z` itself when inactive. Errors: [`Error::LengthMismatch`]
+    /// for a frame of another length, [`Error::Overflow`] if the whitened frame's energy
+    /// overflows `f32` (an input within `1 / min w` of `f32::MAX`).
+    pub fn apply<'a>(&'a mut self, z: &'a [Complex32]) -> Result<&'a [Complex32]> {
+        let m = self.m;
+        if m == 0 {
+            return Ok(z);
+        }
+        if z.len() != m {
+            return Err(Error::LengthMismatch {
+                expected: m,
+                got: z.len(),
+            });
+        }
+        let kernel = self.kernel.get(..m).unwrap_or(&[]);
+        let mut energy = 0.0f32;
+        for (b, out) in self.out.iter_mut().enumerate().take(m) {
+            // z'_b = sum_k c_((b - k) mod m) z_k: k = 0..=b uses c_b .. c_0, k > b uses
+            // c_(m-1) .. c_(b+1).
+            let (Some((head, tail)), Some((c_lo, c_hi))) =
+                (z.split_at_checked(b + 1), kernel.split_at_checked(b + 1))
+            else {
+                continue; // b < m = z.len() = kernel.len(): never taken
+            };
+            let (mut re, mut im) = (0.0f32, 0.0f32);
+            for (zk, c) in head.iter().zip(c_lo.iter().rev()) {
+                re += c.re * zk.re - c.im * zk.im;
+                im += c.re * zk.im + c.im * zk.re;
+            }
+            for (zk, c) in tail.iter().zip(c_hi.iter().rev()) {
+                re += c.re * zk.re - c.im * zk.im;
+                im += c.re * zk.im + c.im * zk.re;
+            }
+            *out = Complex32::new(re, im);
+            energy += re * re + im * im;
+        }
+        if !energy.is_finite() {
+            return Err(Error::Overflow);
+        }
+        Ok(self.out.get(..m).unwrap_or(&[]))
+    }
+}

@@ -9,7 +9,7 @@ use super::evaluation::{ComparatorModel, Likelihood, VarSource};
 use crate::cli;
 use crate::scenario::crpf::{Noise, Othr};
 use faint_core::detect::pf_tbd::BirthProposal;
-use faint_core::model::doppler::Window;
+use faint_core::model::doppler::{Phase, Window};
 
 /// Analysis window of the scene and every detector's model (`--window`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -77,13 +77,21 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = VarSource::Run)]
     pub comparator_var: VarSource,
     /// Likelihood of the Gaussian comparators: independent bins (the preset) or the
-    /// window's bin covariance taken into account (`window`: frames whitened, see
-    /// `faint_core::model::doppler::unwindow`).
+    /// window's bin covariance taken into account (`window`: frames whitened in the
+    /// detectors' step, `GaussConfig::likelihood`).
     #[arg(long, value_enum, default_value_t = Likelihood::Independent)]
     pub comparator_likelihood: Likelihood,
     /// Analysis window of the scene and of every detector's model.
     #[arg(long, value_enum, default_value_t = SceneWindow::Hamming)]
     pub window: SceneWindow,
+    /// The four detectors' phase model (`config.model.phase`): `zero` (eq. 17, the
+    /// paper) or `unknown` (the cost minimised, the likelihood averaged over the phase).
+    #[arg(long, value_enum, default_value_t = PhaseModel::Zero)]
+    pub phase: PhaseModel,
+    /// The simulated target's phase at each frame's start: `zero` (eq. 17, the paper)
+    /// or `random` (uniform, independent per frame: independent dwells).
+    #[arg(long, value_enum, default_value_t = EchoPhase::Zero)]
+    pub echo_phase: EchoPhase,
     /// Birth proposal of PF-TBD and JOTT: `exact` (the preset: JOTT births in their exact
     /// proportion, PF-TBD's absent particles born at rate Pb) or `fixed-share:<s>` (a
     /// share s in (0, 1) of the particles proposed as births every frame, importance
@@ -94,6 +102,35 @@ pub struct Args {
     /// SNR 0:16:4, sweeps with 200 + 40 runs; never overrides a value given.
     #[arg(long)]
     pub quick: bool,
+}
+
+/// The detectors' phase model (`--phase`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum PhaseModel {
+    /// Zero at each frame's start (eq. 17; the presets).
+    #[default]
+    Zero,
+    /// Unknown, independent per frame.
+    Unknown,
+}
+
+impl From<PhaseModel> for Phase {
+    fn from(p: PhaseModel) -> Self {
+        match p {
+            PhaseModel::Zero => Phase::Zero,
+            PhaseModel::Unknown => Phase::Unknown,
+        }
+    }
+}
+
+/// The simulated echo's phase (`--echo-phase`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum EchoPhase {
+    /// Zero at each frame's start (eq. 17; the paper's scene).
+    #[default]
+    Zero,
+    /// Uniform, independent per frame.
+    Random,
 }
 
 /// The arguments after the `--quick` defaults, checked.
@@ -114,6 +151,8 @@ pub(super) struct Settings {
     pub(super) comparator_var: VarSource,
     pub(super) comparator_likelihood: Likelihood,
     pub(super) window: SceneWindow,
+    pub(super) phase: PhaseModel,
+    pub(super) echo_phase: EchoPhase,
     pub(super) birth: BirthProposal,
 }
 
@@ -175,6 +214,8 @@ impl Args {
             comparator_var: self.comparator_var,
             comparator_likelihood: self.comparator_likelihood,
             window: self.window,
+            phase: self.phase,
+            echo_phase: self.echo_phase,
             birth,
         })
     }
@@ -202,8 +243,8 @@ impl Settings {
     }
 
     /// Output sub-directory: `<noise>_n<N>`, with `_var-true`, `_lik-window`, `_rect`,
-    /// `_birth-fs<s>` for the non-preset comparator variance, likelihood, window and birth
-    /// proposal.
+    /// `_phase-unknown`, `_echo-random`, `_birth-fs<s>` for the non-preset comparator
+    /// variance, likelihood, window, phase model, echo phase and birth proposal.
     pub(super) fn tag(&self) -> String {
         let mut t = format!("{:?}_n{}", self.noise, self.particles).to_lowercase();
         if self.comparator_var == VarSource::True {
@@ -214,6 +255,12 @@ impl Settings {
         }
         if self.window == SceneWindow::Rectangular {
             t += "_rect";
+        }
+        if self.phase == PhaseModel::Unknown {
+            t += "_phase-unknown";
+        }
+        if self.echo_phase == EchoPhase::Random {
+            t += "_echo-random";
         }
         if let BirthProposal::FixedShare(s) = self.birth {
             t += &format!("_birth-fs{s}");

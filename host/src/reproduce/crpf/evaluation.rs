@@ -9,7 +9,9 @@ use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd};
 use faint_core::detect::Detector;
-use faint_core::model::doppler::{estimate_noise_variance, unwindow, DopplerReport, Window};
+use faint_core::model::doppler::{
+    estimate_noise_variance, DopplerReport, Likelihood as CoreLikelihood, Whitener, Window,
+};
 use faint_core::rng::{derive_seed, Rng};
 use faint_core::statistic::{d_k, zeta_k};
 use faint_core::Complex32;
@@ -65,8 +67,7 @@ pub enum VarSource {
     /// Estimated from the run's K frames, `sum_k ||z_k||^2 / (K m)` (includes the target).
     #[default]
     Run,
-    /// The scene's true per-bin variance (time-domain variance times `sum w^2`, or `m`
-    /// for whitened frames).
+    /// The scene's true per-bin variance (time-domain variance times `sum w^2`).
     True,
 }
 
@@ -77,10 +78,9 @@ pub enum Likelihood {
     /// Independent bins of the windowed frame (the preset).
     #[default]
     Independent,
-    /// The window's bin covariance taken into account: frames whitened by
-    /// [`unwindow`], the rectangular window's response, per-bin variance `m s2`
-    /// (the exact Gaussian likelihood under the correlated bins; `faint_core::model::doppler`
-    /// module `whiten`).
+    /// The window's bin covariance taken into account (`GaussConfig::likelihood` =
+    /// `window`: each frame whitened in the detectors' step, the rectangular window's
+    /// response; the exact Gaussian likelihood under the correlated bins).
     Window,
 }
 
@@ -125,49 +125,55 @@ impl From<ComparatorModel> for Comparators {
     }
 }
 
-/// The comparators' frames, model and per-bin variance for one run under `cm`
-/// (`window`: the scene's and CRPF-TBD's analysis window).
-fn comparator_input(
+/// The comparators' configuration for one run under `cm` (`model`: CRPF-TBD's, whose
+/// window is the scene's analysis window). The window-aware likelihood whitens the frames
+/// in the detectors' step (`GaussConfig::likelihood`); the variance is always that of the
+/// windowed bins.
+fn comparator_config(
     run: &Run,
     model: faint_core::model::doppler::ModelConfig,
     cm: &ComparatorModel,
-) -> Result<(Option<Run>, GaussConfig)> {
+) -> Result<GaussConfig> {
     let m = run.frames.first().map_or(0, Vec::len);
-    let window = model.window;
-    let (whitened, model) = match cm.likelihood {
-        Likelihood::Independent => (None, model),
-        Likelihood::Window => {
-            let mut frames = run.frames.clone();
-            for f in frames.iter_mut() {
-                unwindow(f, window).map_err(|e| anyhow::anyhow!("{e}"))?;
-            }
-            let mut rect = model;
-            rect.window = Window::Rectangular;
-            (
-                Some(Run {
-                    frames,
-                    truth: run.truth.clone(),
-                }),
-                rect,
-            )
-        }
-    };
-    let frames = whitened.as_ref().unwrap_or(run);
     let noise_var = match cm.var {
-        VarSource::Run => estimate_noise_variance(frames.frames.iter().map(|f| f.as_slice()), m)?,
+        VarSource::Run => match cm.likelihood {
+            Likelihood::Independent => {
+                estimate_noise_variance(run.frames.iter().map(|f| f.as_slice()), m)?
+            }
+            Likelihood::Window => whitened_run_variance(run, model.window, m)?,
+        },
         VarSource::True => {
             let e: f64 = (0..m).map(|n| model.window.coefficient(n, m).powi(2)).sum();
             (cm.time_var * e) as f32
         }
     };
-    Ok((
-        whitened,
-        GaussConfig {
-            model,
-            noise_var,
-            birth: cm.birth,
+    Ok(GaussConfig {
+        model,
+        noise_var,
+        birth: cm.birth,
+        likelihood: match cm.likelihood {
+            Likelihood::Independent => CoreLikelihood::Independent,
+            Likelihood::Window => CoreLikelihood::Window,
         },
-    ))
+    })
+}
+
+/// The run's noise variance estimated on the frames the window-aware likelihood weighs:
+/// `sum_k ||z'_k||^2 / (K m)` of the whitened frames (`Whitener`), returned in the
+/// windowed bins' units (times `sum w^2 / m`), as `GaussConfig::noise_var` takes it.
+/// Under heavy-tailed noise this differs from the windowed frames' estimate (a large
+/// sample near the window's edge counts fully in the whitened frame, little in the
+/// windowed one); under Gaussian noise both estimate the same value.
+fn whitened_run_variance(run: &Run, window: Window, m: usize) -> Result<f32> {
+    let mut wh = Whitener::inactive();
+    wh.configure(CoreLikelihood::Window, window, m)?;
+    let mut white = Vec::with_capacity(run.frames.len());
+    for f in &run.frames {
+        white.push(wh.apply(f)?.to_vec());
+    }
+    let v = estimate_noise_variance(white.iter().map(|f| f.as_slice()), m)?;
+    let e: f64 = (0..m).map(|n| window.coefficient(n, m).powi(2)).sum();
+    Ok((f64::from(v) * e / m as f64) as f32)
 }
 
 /// Runs a detector over a run's frames; returns the per-frame reports.
@@ -219,8 +225,7 @@ fn stats_of<const N: usize>(
     let Some(cm) = comparators.0 else {
         return Ok(st);
     };
-    let (whitened, g) = comparator_input(run, crpf_cfg.model, &cm)?;
-    let run = whitened.as_ref().unwrap_or(run);
+    let g = comparator_config(run, crpf_cfg.model, &cm)?;
     let mut pf = Box::new(PfTbd::<N>::new(g, derive_seed(seed, 2))?);
     let rp: Vec<f32> = run_detector(pf.as_mut(), run)?
         .iter()

@@ -24,7 +24,7 @@ use faint_core::rng::derive_seed;
 
 use crate::scenario::crpf::Othr;
 
-pub use args::{Args, SceneWindow, PARTICLES};
+pub use args::{Args, EchoPhase, PhaseModel, SceneWindow, PARTICLES};
 pub use calibration::calibration;
 pub use evaluation::{
     batch, run_detector, run_stats, ComparatorModel, Comparators, Likelihood, Stats, VarSource,
@@ -37,10 +37,12 @@ pub fn run(args: &Args) -> Result<()> {
     let grid = a.grid.clone();
     let sc = Othr {
         window: a.window.into(),
+        random_phase: a.echo_phase == EchoPhase::Random,
         ..Othr::default()
     };
     let mut cfg = CrpfConfig::othr();
     cfg.model.window = sc.window;
+    cfg.model.phase = a.phase.into();
     let tag = a.tag();
     let dir = a.out.join(&tag);
     crate::cli::out_dir(&dir)?;
