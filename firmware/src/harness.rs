@@ -41,10 +41,14 @@ use core::sync::atomic::{compiler_fence, AtomicBool, AtomicU32, Ordering};
 use cortex_m_rt::{exception, ExceptionFrame};
 use cortex_m_semihosting::{debug, hprintln};
 
-/// CMSDK APB timer0 of the MPS2 board.
+/// CMSDK APB timer0 of the MPS2 board (not used with the `dwt` feature).
+#[cfg(not(feature = "dwt"))]
 const TIMER0: usize = 0x4000_0000;
+#[cfg(not(feature = "dwt"))]
 const TIMER_CTRL: *mut u32 = TIMER0 as *mut u32;
+#[cfg(not(feature = "dwt"))]
 const TIMER_VALUE: *mut u32 = (TIMER0 + 0x4) as *mut u32;
+#[cfg(not(feature = "dwt"))]
 const TIMER_RELOAD: *mut u32 = (TIMER0 + 0x8) as *mut u32;
 
 /// Bytes below the stack pointer painted by [`measure`] to find the closure's peak
@@ -152,6 +156,7 @@ fn elapsed(t0: u32, t1: u32) -> u32 {
 }
 
 /// Timer ticks (25 MHz) to instructions at `-icount shift=10` (1024 ns each).
+#[cfg_attr(feature = "dwt", allow(dead_code))]
 pub const fn ticks_to_instructions(ticks: u32) -> u32 {
     ((ticks as u64 * 40 + 512) >> 10) as u32
 }

@@ -325,6 +325,15 @@ macro_rules! zeroed {
     };
 }
 
+/// The `&mut` to a static.
+///
+/// # Safety
+/// `p` points to a static that nothing else references while the result lives.
+unsafe fn only_ref<T>(p: *mut T) -> &'static mut T {
+    // SAFETY: the caller's contract.
+    unsafe { &mut *p }
+}
+
 zeroed!(CRPF_1000: CrpfTbd<1000>);
 zeroed!(PF_1000: PfTbd<1000>);
 zeroed!(JOTT_1000: BernoulliTbd<1000>);
@@ -359,11 +368,11 @@ fn crpf() {
     // SAFETY: single-threaded; each static is referenced only here, once.
     let (c1, pf, jott, lrt, c6) = unsafe {
         (
-            &mut *(&raw mut CRPF_1000),
-            &mut *(&raw mut PF_1000),
-            &mut *(&raw mut JOTT_1000),
-            &mut *(&raw mut LRT_1000),
-            &mut *(&raw mut CRPF_6000),
+            only_ref(&raw mut CRPF_1000),
+            only_ref(&raw mut PF_1000),
+            only_ref(&raw mut JOTT_1000),
+            only_ref(&raw mut LRT_1000),
+            only_ref(&raw mut CRPF_6000),
         )
     };
     check(c1.configure(&CrpfConfig::othr(), SEED));
@@ -455,7 +464,7 @@ fn phd() {
     use faint_golden::phd::{config, cube, ALGORITHMS, FIRMWARE_WINDOW};
     const SEED: u64 = 0x0002_0019_9E1D_7BD0;
     // SAFETY: single-threaded; the static is referenced only here, once.
-    let det = unsafe { &mut *(&raw mut PHD) };
+    let det = unsafe { only_ref(&raw mut PHD) };
     let buf = CUBE.take();
     let mut label = Text::<96>::new();
     for (alg, frames) in ALGORITHMS.into_iter().zip([2usize, 2]) {
@@ -483,7 +492,7 @@ fn cbmember() {
     use faint_golden::cbmember::{config, map};
     const SEED: u64 = 0x0003_CB3E_3BE7_2023;
     // SAFETY: single-threaded; the static is referenced only here, once.
-    let det = unsafe { &mut *(&raw mut CBM) };
+    let det = unsafe { only_ref(&raw mut CBM) };
     let z = MAP.take();
     let g = faint_core::detect::cbmember::CbmemberConfig::rotor_uav().geometry;
     let cfg = config(g, PointModel::Joint, 1000, 450);
@@ -523,7 +532,7 @@ fn dp_rows<D: DpTrack>(name: &str, det: &mut D, cfg: DpConfig, last: usize) {
     use faint_golden::dp::{frame, SIGMA};
     const SEED: u64 = 0x0004_D9B8_CDB8_7468;
     // SAFETY: single-threaded; the image is used by one detector at a time.
-    let image = unsafe { &mut *(&raw mut IMAGE) };
+    let image = unsafe { only_ref(&raw mut IMAGE) };
     check(det.configure(&cfg, 0));
     let mut rng = Rng::from_stream(SEED, 1);
     let mut label = Text::<96>::new();

@@ -86,6 +86,10 @@ pub struct Tracer {
     pending: Option<usize>,
     active: bool,
     predictor: HashMap<u32, (u8, u32)>,
+    /// The block the pending one was entered from by falling through (no branch).
+    fall: Option<usize>,
+    /// Cost corrections of a fall-through pair (a block QEMU split, see [`Tracer::seam`]).
+    seams: HashMap<(usize, usize), (i64, i64)>,
     pub regions: Vec<Totals>,
     /// Trace lines whose translation was never printed, and other oddities.
     pub unknown: u64,
@@ -104,6 +108,8 @@ impl Tracer {
             pending: None,
             active: false,
             predictor: HashMap::new(),
+            fall: None,
+            seams: HashMap::new(),
             regions: Vec::new(),
             unknown: 0,
             lines: 0,
@@ -142,6 +148,7 @@ impl Tracer {
             }
         } else if l.starts_with("Stopped execution of TB chain") {
             self.pending = None;
+            self.fall = None;
         }
     }
 
@@ -187,6 +194,7 @@ impl Tracer {
         } else {
             self.unknown += 1;
             self.pending = None;
+            self.fall = None;
             return;
         };
         // The previous TB ran (this one follows it): cost it, then apply its marker.
@@ -204,11 +212,34 @@ impl Tracer {
         self.pending = Some(id);
     }
 
+    /// Cycles to add when `second` runs right after `first` by falling through: QEMU ends
+    /// a block early (icount budget, I/O, page end) at points that depend on the run, so
+    /// the pair is costed as the one block it is (load pipelining, M7 pairing across the
+    /// seam), which keeps the totals independent of where QEMU split it.
+    fn seam(&mut self, first: usize, second: usize) -> (i64, i64) {
+        if let Some(&d) = self.seams.get(&(first, second)) {
+            return d;
+        }
+        let (a, b) = (&self.blocks[first], &self.blocks[second]);
+        let joint: Vec<Insn> = a.insns.iter().chain(&b.insns).cloned().collect();
+        let (m4, m7) = costs(&joint, &self.p);
+        let d = (
+            m4 as i64 - a.m4 as i64 - b.m4 as i64,
+            m7 as i64 - a.m7 as i64 - b.m7 as i64,
+        );
+        self.seams.insert((first, second), d);
+        d
+    }
+
     fn cost(&mut self, prev: usize, next_pc: u32, next: usize, next_cflags: u32) {
+        let fell_from = self.fall.take();
         let b = &self.blocks[prev];
         let Some(last) = b.insns.last() else {
             return;
         };
+        if !last.writes_pc && next_pc == b.end {
+            self.fall = Some(prev);
+        }
         // M7 branch prediction, trained everywhere (also outside regions).
         let taken = last.writes_pc && next_pc != b.end;
         let mut m7_extra = 0;
@@ -248,14 +279,18 @@ impl Tracer {
             };
             (b.insns.len() as u64, b.m4 + refill, b.m7 + m7_extra)
         };
+        let (d4, d7) = match fell_from {
+            Some(f) if self.blocks[f].marker == Marker::None => self.seam(f, prev),
+            _ => (0, 0),
+        };
         let r = self
             .regions
             .last_mut()
             .expect("a region is open when active");
         r.instructions += n;
         r.blocks += 1;
-        r.m4 += m4;
-        r.m7 += m7;
+        r.m4 = r.m4.wrapping_add(m4).wrapping_add_signed(d4);
+        r.m7 = r.m7.wrapping_add(m7).wrapping_add_signed(d7);
         if self.hot {
             let e = r.per_block.entry(prev).or_insert((0, 0));
             e.0 += 1;
@@ -331,6 +366,52 @@ Trace 0: 0x7f0000000400 [00000000/00000300/00000110/ff020200] faint_cycles_end
         assert_eq!(r.instructions, 7);
         // subs 1 + bne 1 (+ P = 1 when taken, twice) three times; bl 1 + P = 1.
         assert_eq!(r.m4, 3 * 2 + 2 + 2);
+    }
+
+    /// A block QEMU split in two (no branch between the halves) costs what the whole
+    /// block costs: the second load still pipelines with the first.
+    #[test]
+    fn a_split_block_costs_the_whole_block() {
+        let run = |split: bool| -> u64 {
+            let mut t = Tracer::new(Params::default(), false);
+            let mut log = vec![
+                "IN: faint_cycles_begin",
+                "0x00000100:  4770       bx       lr",
+                "Trace 0: 0x10 [00000000/00000100/00000110/ff020200] faint_cycles_begin",
+            ];
+            if split {
+                log.extend([
+                    "IN: x",
+                    "0x00000200:  6820       ldr      r0, [r4]",
+                    "Trace 0: 0x20 [00000000/00000200/00000110/ff020201] x",
+                    "IN: x",
+                    "0x00000202:  6861       ldr      r1, [r4, #4]",
+                    "0x00000204:  e000       b        #0x208",
+                    "Trace 0: 0x28 [00000000/00000202/00000110/ff020200] x",
+                ]);
+            } else {
+                log.extend([
+                    "IN: x",
+                    "0x00000200:  6820       ldr      r0, [r4]",
+                    "0x00000202:  6861       ldr      r1, [r4, #4]",
+                    "0x00000204:  e000       b        #0x208",
+                    "Trace 0: 0x20 [00000000/00000200/00000110/ff020200] x",
+                ]);
+            }
+            log.extend([
+                "IN: faint_cycles_end",
+                "0x00000208:  4770       bx       lr",
+                "Trace 0: 0x30 [00000000/00000208/00000110/ff020200] faint_cycles_end",
+            ]);
+            for l in log {
+                t.line(l);
+            }
+            assert_eq!(t.regions[0].instructions, 3);
+            t.regions[0].m4
+        };
+        // 2 + 1 (pipelined) + b (1 + P = 1)
+        assert_eq!(run(false), 5);
+        assert_eq!(run(true), 5);
     }
 
     #[test]
