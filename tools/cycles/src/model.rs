@@ -22,7 +22,7 @@
 //! VMOV of two core registers (double or two singles)                   2
 //! VMLA, VMLS, VNMLA, VNMLS, VFMA, VFMS, VFNMA, VFNMS                   3
 //! VDIV, VSQRT                              14
-//! IT and the instructions it skips         1 each
+//! IT                                       1 (an instruction it skips costs as if run)
 //! P (pipeline refill) = 1, + 1 when the target is a 32-bit instruction that is not
 //!   word-aligned (two fetches), + 1 for a register target (BX, POP/LDR PC, TBB/TBH:
 //!   no early target speculation), + `wait_states`
