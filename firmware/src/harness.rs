@@ -12,10 +12,12 @@
 //!
 //! minus the count of an empty measurement. The result is an **executed-instruction
 //! count**, not Cortex-M4 cycles: loads, taken branches, divisions and FPU divides take
-//! more than one cycle on silicon and flash wait states add more, so cycles exceed this
-//! count by a factor that only a board measurement gives (not measured here). It is exact and
-//! deterministic: two runs print the same numbers. [`calibrate`] checks the conversion
-//! against a hand-written loop of known length at start-up.
+//! more than one cycle on silicon and flash wait states add more. The cycle model
+//! (`tools/cycles`, the `cycles` binary) estimates Cortex-M4 and M7 cycles from QEMU's
+//! trace; on a board, build with the `dwt` feature and the same calls count cycles with
+//! DWT `CYCCNT` (enabled by `init`: `DEMCR.TRCENA`, then `DWT_CTRL.CYCCNTENA`). It is
+//! exact and deterministic: two runs print the same numbers. [`calibrate`] checks the
+//! conversion against a hand-written loop of known length at start-up.
 //!
 //! **Use from a detector module** (`firmware/src/<name>.rs`, one `pub fn run()` called
 //! from `main.rs`):
@@ -39,10 +41,14 @@ use core::sync::atomic::{compiler_fence, AtomicBool, AtomicU32, Ordering};
 use cortex_m_rt::{exception, ExceptionFrame};
 use cortex_m_semihosting::{debug, hprintln};
 
-/// CMSDK APB timer0 of the MPS2 board.
+/// CMSDK APB timer0 of the MPS2 board (not used with the `dwt` feature).
+#[cfg(not(feature = "dwt"))]
 const TIMER0: usize = 0x4000_0000;
+#[cfg(not(feature = "dwt"))]
 const TIMER_CTRL: *mut u32 = TIMER0 as *mut u32;
+#[cfg(not(feature = "dwt"))]
 const TIMER_VALUE: *mut u32 = (TIMER0 + 0x4) as *mut u32;
+#[cfg(not(feature = "dwt"))]
 const TIMER_RELOAD: *mut u32 = (TIMER0 + 0x8) as *mut u32;
 
 /// Bytes below the stack pointer painted by [`measure`] to find the closure's peak
@@ -87,8 +93,19 @@ impl<T> Static<T> {
     }
 }
 
+/// Debug Exception and Monitor Control Register (TRCENA is bit 24).
+#[cfg(feature = "dwt")]
+const DEMCR: *mut u32 = 0xE000_EDFC as *mut u32;
+/// DWT control register (CYCCNTENA is bit 0) and the cycle counter.
+#[cfg(feature = "dwt")]
+const DWT_CTRL: *mut u32 = 0xE000_1000 as *mut u32;
+#[cfg(feature = "dwt")]
+const DWT_CYCCNT: *mut u32 = 0xE000_1004 as *mut u32;
+
 /// Starts timer0 as a free-running 32-bit down-counter and measures the empty baseline.
+/// With the `dwt` feature (silicon) it enables the cycle counter instead.
 pub fn init() {
+    #[cfg(not(feature = "dwt"))]
     // SAFETY: timer0's registers on the MPS2 memory map; nothing else uses the timer.
     unsafe {
         write_volatile(TIMER_CTRL, 0);
@@ -96,18 +113,50 @@ pub fn init() {
         write_volatile(TIMER_VALUE, u32::MAX);
         write_volatile(TIMER_CTRL, 1);
     }
+    #[cfg(feature = "dwt")]
+    // SAFETY: the architecture's debug registers (ARMv7-M C1.6.5, C1.8.7): TRCENA powers
+    // the DWT, CYCCNTENA starts the counter.
+    unsafe {
+        write_volatile(DEMCR, read_volatile(DEMCR) | 1 << 24);
+        write_volatile(DWT_CYCCNT, 0);
+        write_volatile(DWT_CTRL, read_volatile(DWT_CTRL) | 1);
+    }
     BASELINE.store(0, Ordering::Relaxed);
     let ((), base) = raw_instructions(|| ());
     BASELINE.store(base, Ordering::Relaxed);
 }
 
+#[cfg(not(feature = "dwt"))]
 #[inline(always)]
 fn timer() -> u32 {
     // SAFETY: read of a device register.
     unsafe { read_volatile(TIMER_VALUE) }
 }
 
+/// The cycle counter (`dwt` feature: on silicon; QEMU does not count DWT cycles).
+#[cfg(feature = "dwt")]
+#[inline(always)]
+fn timer() -> u32 {
+    // SAFETY: read of a debug register.
+    unsafe { read_volatile(DWT_CYCCNT) }
+}
+
+/// Counts between two [`timer`] reads: instructions from timer0 (a down-counter), or
+/// cycles from CYCCNT (an up-counter) with the `dwt` feature.
+#[inline(always)]
+fn elapsed(t0: u32, t1: u32) -> u32 {
+    #[cfg(not(feature = "dwt"))]
+    {
+        ticks_to_instructions(t0.wrapping_sub(t1))
+    }
+    #[cfg(feature = "dwt")]
+    {
+        t1.wrapping_sub(t0)
+    }
+}
+
 /// Timer ticks (25 MHz) to instructions at `-icount shift=10` (1024 ns each).
+#[cfg_attr(feature = "dwt", allow(dead_code))]
 pub const fn ticks_to_instructions(ticks: u32) -> u32 {
     ((ticks as u64 * 40 + 512) >> 10) as u32
 }
@@ -131,8 +180,8 @@ pub fn raw_instructions<R>(f: impl FnOnce() -> R) -> (R, u32) {
     compiler_fence(Ordering::SeqCst);
     let t1 = timer();
     compiler_fence(Ordering::SeqCst);
-    // Down-counter; one wrap (167 M instructions) is handled by the wrapping sub.
-    (r, ticks_to_instructions(t0.wrapping_sub(t1)))
+    // One wrap (167 M instructions, or 2^32 cycles) is handled by the wrapping sub.
+    (r, elapsed(t0, t1))
 }
 
 /// Result of one [`measure`].
@@ -196,6 +245,8 @@ pub fn calibrate() {
         long,
         diff
     );
+    // On silicon (`dwt`) the loop costs 1 + (1 + P) cycles per iteration: no fixed value.
+    #[cfg(not(feature = "dwt"))]
     assert!(
         diff == 20_000,
         "instruction counting is off: run QEMU with -icount shift=10,align=off,sleep=off"
