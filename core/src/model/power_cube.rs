@@ -656,4 +656,92 @@ mod tests {
         psf.for_each_cell(&g, &far, |_, _| k += 1);
         assert_eq!(k, 0);
     }
+
+    #[test]
+    fn spread_validation_bounds_the_cost_and_the_width() {
+        let ok = PointSpread::from_std([2.0, 2.0, 2.0], [6, 6, 6]);
+        assert_eq!(ok.covered(), 2197);
+        assert!(ok.validate().is_ok());
+        for bad in [
+            PointSpread {
+                half_width: [9, 0, 0],
+                ..ok
+            },
+            PointSpread {
+                half_width: [8, 8, 8],
+                ..ok
+            },
+            PointSpread::from_std([17.0, 1.0, 1.0], [1, 1, 1]),
+            PointSpread::from_std([0.0, 1.0, 1.0], [1, 1, 1]),
+            PointSpread {
+                loss_doppler: f32::NAN,
+                ..ok
+            },
+        ] {
+            assert!(bad.validate().is_err(), "{bad:?}");
+        }
+        assert_eq!(PointSpread::ONE_CELL.peak_radius(0), 1);
+        assert_eq!(ok.peak_radius(1), 2);
+        assert_eq!(PointSpread::from_std([0.5; 3], [1; 3]).peak_radius(2), 1);
+        assert_eq!(ok.central().half_width, [1, 1, 1]);
+    }
+
+    /// Per-axis half widths and losses against an f64 evaluation of eq. 3 at every
+    /// covered cell (tolerance: f32 rounding of `exp` of an argument up to ~50, relative
+    /// 1e-5), for the widest valid spreads; `log_lr` stays finite on a cube of large
+    /// powers at every position, in the cube or outside it.
+    #[test]
+    fn per_axis_spread_matches_eq3_and_log_lr_stays_finite() {
+        let g = CubeGeometry {
+            n_range: 30,
+            n_doppler: 20,
+            n_azimuth: 25,
+            ..geom()
+        };
+        let data: std::vec::Vec<f32> = (0..g.len()).map(|i| (i % 97) as f32 * 1e3).collect();
+        let cube = PowerCube::new(&data, g).unwrap();
+        for psf in [
+            PointSpread::from_std([2.0, 0.5, 16.0], [6, 1, 8]),
+            PointSpread::from_std([16.0, 16.0, 16.0], [6, 6, 6]),
+            PointSpread::from_std([0.0625, 1.0, 3.0], [0, 8, 3]),
+        ] {
+            psf.validate().unwrap();
+            let c = RadarCoords {
+                range: 310.0,
+                doppler: 4.3,
+                azimuth_deg: 11.7,
+            };
+            let (fr, fd, fb) = g.fractional(&c);
+            let mut n = 0;
+            psf.for_each_cell(&g, &c, |idx, h| {
+                let (i, j, l) = g.unindex(idx);
+                let d = |k: usize, f: f32| k as f64 + 0.5 - f as f64;
+                let want = (-0.5
+                    * (psf.loss_range as f64 * d(i, fr).powi(2)
+                        + psf.loss_doppler as f64 * d(j, fd).powi(2)
+                        + psf.loss_azimuth as f64 * d(l, fb).powi(2)))
+                .exp();
+                assert!((h as f64 - want).abs() <= 1e-5 * want + 1e-30, "{h} {want}");
+                n += 1;
+            });
+            let interior: usize = (0..3).map(|a| 2 * psf.half(a) + 1).product();
+            assert!(n <= interior && n > 0);
+            for (r, d, b) in [
+                (310.0, 4.3, 11.7),
+                (-1e30, 0.0, 0.0),
+                (1e6, -1e6, 1e6),
+                (f32::NAN, 0.0, 0.0),
+            ] {
+                let rc = RadarCoords {
+                    range: r,
+                    doppler: d,
+                    azimuth_deg: b,
+                };
+                for amp in [0.0, 1.0, 1e6] {
+                    let l = cube.log_lr(&psf, &rc, amp, 0.5);
+                    assert!(l.is_finite(), "{psf:?} {rc:?} {amp}: {l}");
+                }
+            }
+        }
+    }
 }
