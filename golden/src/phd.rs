@@ -83,7 +83,7 @@ pub const PSF: PointSpread = PointSpread {
     loss_range: 1.0,
     loss_doppler: 1.0,
     loss_azimuth: 1.0,
-    half_width: 1,
+    half_width: [1, 1, 1],
 };
 
 /// Target power `P = 2 sigma^2 10^(SNR/10)`.

@@ -8,3 +8,4 @@ mod cli;
 #[path = "../common/cli.rs"]
 mod common;
 mod filter;
+mod spread;

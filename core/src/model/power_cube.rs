@@ -177,10 +177,13 @@ impl CubeGeometry {
 /// The separable point spread of eq. 3, in cell units:
 /// `h = exp(-L_r (r_i - r)^2 / (2 R^2) - L_d (d_j - d)^2 / (2 D^2) - L_b (b_l - b)^2 / (2 B^2))`.
 ///
-/// The paper writes `(r_i - r)^2 / (2R) L_r`; its loss factor is ours divided by the cell
-/// size, so `L = 1` here means a spread whose standard deviation is one cell. Only the
-/// `(2 half_width + 1)^3` cells around the target's own cell are covered (the same
-/// truncation in the simulator and in the likelihood).
+/// One convention: `L` is the loss in cell units, `L = 1 / s^2` for a spread whose
+/// standard deviation is `s` cells on that axis (`L = 1`: one cell; `L = 0.25`: two
+/// cells). The paper writes `(r_i - r)^2 L_r / (2R)`; its loss factor is ours divided by
+/// the cell size, `L_paper = L / R`. Only the `(2 w_r + 1) (2 w_d + 1) (2 w_b + 1)` cells
+/// around the target's own cell are covered, `w = half_width` per axis (the same
+/// truncation in the simulator and in the likelihood); a half width of about `2 s`
+/// covers the cells where `h > exp(-2)` of the peak.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(
     feature = "serde",
@@ -188,71 +191,166 @@ impl CubeGeometry {
     serde(deny_unknown_fields)
 )]
 pub struct PointSpread {
-    /// Range loss `L_r`.
+    /// Range loss `L_r = 1 / s_r^2` (cell units).
     pub loss_range: f32,
-    /// Doppler loss `L_d`.
+    /// Doppler loss `L_d = 1 / s_d^2` (cell units).
     pub loss_doppler: f32,
-    /// Azimuth loss `L_b`.
+    /// Azimuth loss `L_b = 1 / s_b^2` (cell units).
     pub loss_azimuth: f32,
-    /// Cells covered on each side of the target's cell, on every axis (0..=3).
-    pub half_width: usize,
+    /// Cells covered on each side of the target's cell: range, Doppler, azimuth (each
+    /// `0..=8`, at most [`MAX_COVERED_CELLS`] cells in all).
+    pub half_width: [usize; 3],
 }
 
-/// Largest supported [`PointSpread::half_width`].
-pub const MAX_HALF_WIDTH: usize = 3;
+/// Largest supported half width of one axis of a [`PointSpread`].
+pub const MAX_HALF_WIDTH: usize = 8;
 const MAX_SPAN: usize = 2 * MAX_HALF_WIDTH + 1;
 
+/// Most cells one particle's spread may cover, `(2 w_r + 1) (2 w_d + 1) (2 w_b + 1)`:
+/// the bound of the per-particle cost of the likelihood (one `ln I0` per covered cell,
+/// `3 (2w + 1) <= 51` exponentials). `13^3`: a two-cell spread on every axis at
+/// `w = 6` (3 standard deviations), or a wider spread on fewer axes.
+pub const MAX_COVERED_CELLS: usize = 2197;
+
+/// Smallest loss (cell units) of a [`PointSpread`] axis: a standard deviation of at most
+/// 16 cells, twice the widest half width.
+pub const MIN_LOSS: f32 = 1.0 / 256.0;
+
 impl PointSpread {
+    /// The spread used before the losses were set per sensor: one-cell standard deviation
+    /// and half width 1 on every axis (3 x 3 x 3 cells).
+    pub const ONE_CELL: Self = Self {
+        loss_range: 1.0,
+        loss_doppler: 1.0,
+        loss_azimuth: 1.0,
+        half_width: [1, 1, 1],
+    };
+
+    /// The spread with standard deviations `std` (cells: range, Doppler, azimuth) and
+    /// half widths `half_width`: `L = 1 / std^2` per axis.
+    pub fn from_std(std: [f32; 3], half_width: [usize; 3]) -> Self {
+        let loss = std.map(|s| 1.0 / (s * s));
+        Self {
+            loss_range: loss[0],
+            loss_doppler: loss[1],
+            loss_azimuth: loss[2],
+            half_width,
+        }
+    }
+
+    /// The same losses over at most one cell on each side of the target's cell
+    /// (`3 x 3 x 3` cells at most): the window of the cube-wide peak statistics
+    /// `sum h^2 z` (births, swarm points), whose cost per cell stays 27 products
+    /// whatever the spread. Equal to `self` for half widths of at most 1.
+    pub fn central(&self) -> Self {
+        Self {
+            half_width: self.half_width.map(|w| w.min(1)),
+            ..*self
+        }
+    }
+
     /// Checks the losses and the coverage.
     pub fn validate(&self) -> Result<()> {
         for v in [self.loss_range, self.loss_doppler, self.loss_azimuth] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(Error::InvalidConfig("point-spread losses must be positive"));
+            if !(v.is_finite() && v >= MIN_LOSS) {
+                return Err(Error::InvalidConfig(
+                    "point-spread losses must be >= 1/256 (a std of at most 16 cells)",
+                ));
             }
         }
-        if self.half_width > MAX_HALF_WIDTH {
-            return Err(Error::InvalidConfig("point-spread half width above 3"));
+        if self.half_width.iter().any(|&w| w > MAX_HALF_WIDTH) {
+            return Err(Error::InvalidConfig("point-spread half width above 8"));
+        }
+        if self.covered() > MAX_COVERED_CELLS {
+            return Err(Error::InvalidConfig(
+                "point spread covers more than 2197 cells per particle",
+            ));
         }
         Ok(())
     }
 
+    /// Half width of axis `a` (0 range, 1 Doppler, 2 azimuth), clamped to
+    /// [`MAX_HALF_WIDTH`].
+    #[inline]
+    pub fn half(&self, a: usize) -> usize {
+        self.half_width
+            .get(a)
+            .copied()
+            .unwrap_or(0)
+            .min(MAX_HALF_WIDTH)
+    }
+
+    /// Loss of axis `a` (0 range, 1 Doppler, 2 azimuth).
+    #[inline]
+    pub fn loss(&self, a: usize) -> f32 {
+        match a {
+            0 => self.loss_range,
+            1 => self.loss_doppler,
+            _ => self.loss_azimuth,
+        }
+    }
+
+    /// Cells covered around an interior target, `prod (2 w + 1)`.
+    pub fn covered(&self) -> usize {
+        (0..3).map(|a| 2 * self.half(a) + 1).product()
+    }
+
+    /// Radius (cells) within which two peaks of the matched statistic `sum h^2 z` are
+    /// taken as one target on axis `a`: the spread's standard deviation `1 / sqrt(L)`
+    /// rounded, at least 1, at most the half width (at least 1).
+    #[inline]
+    pub fn peak_radius(&self, a: usize) -> usize {
+        let s = 1.0 / math::sqrt(self.loss(a));
+        let r = math::round(s);
+        let r = if r.is_finite() && r >= 1.0 {
+            r as usize
+        } else {
+            1
+        };
+        r.min(self.half(a).max(1))
+    }
+
     /// Calls `f(index, h)` for every in-cube cell the spread of `c` covers.
     ///
-    /// Cost: `3 (2w + 1)` exponentials and `(2w + 1)^3` products; cells outside the cube
-    /// are skipped (they contribute a likelihood ratio of 1).
+    /// Cost: `(2w_r + 1) + (2w_d + 1) + (2w_b + 1)` exponentials and
+    /// `(2w_r + 1)(2w_d + 1)(2w_b + 1)` products; cells outside the cube are skipped
+    /// (they contribute a likelihood ratio of 1).
     #[inline]
     pub fn for_each_cell(&self, g: &CubeGeometry, c: &RadarCoords, f: impl FnMut(usize, f32)) {
         let (fr, fd, fb) = g.fractional(c);
-        let r = self.axis_weights(fr, g.n_range, self.loss_range);
-        let d = self.axis_weights(fd, g.n_doppler, self.loss_doppler);
-        let b = self.axis_weights(fb, g.n_azimuth, self.loss_azimuth);
+        let r = self.axis_weights(0, fr, g.n_range);
+        let d = self.axis_weights(1, fd, g.n_doppler);
+        let b = self.axis_weights(2, fb, g.n_azimuth);
         self.for_each_cell_of(g, &r, &d, &b, f);
     }
 
     /// One axis of [`PointSpread::for_each_cell`]: the covered cells and weights
-    /// `exp(-L delta^2 / 2)` around the fractional cell coordinate `frac` (a component of
-    /// [`CubeGeometry::fractional`]) on an axis of `n` cells with loss `loss`. Callers that
-    /// scan a grid of positions compute each axis once per grid line and combine them with
-    /// [`PointSpread::for_each_cell_of`] (bit-identical to `for_each_cell`).
+    /// `exp(-L delta^2 / 2)` of axis `a` (0 range, 1 Doppler, 2 azimuth) around the
+    /// fractional cell coordinate `frac` (a component of [`CubeGeometry::fractional`]) on
+    /// an axis of `n` cells. Callers that scan a grid of positions compute each axis
+    /// once per grid line and combine them with [`PointSpread::for_each_cell_of`]
+    /// (bit-identical to `for_each_cell`).
     #[inline]
-    pub fn axis_weights(&self, frac: f32, n: usize, loss: f32) -> AxisWeights {
-        let mut a = AxisWeights::NONE;
+    pub fn axis_weights(&self, a: usize, frac: f32, n: usize) -> AxisWeights {
+        let mut out = AxisWeights::NONE;
         if !frac.is_finite() {
-            return a;
+            return out;
         }
-        let w = self.half_width.min(MAX_HALF_WIDTH) as i64;
+        let loss = self.loss(a);
+        let w = self.half(a) as i64;
         let span = 2 * w as usize + 1;
+        out.span = span;
         // Clamp so that far-away states do not overflow the i64 conversion.
         let centre = math::floor(frac.clamp(-1.0e6, 1.0e6)) as i64;
-        for k in 0..span {
+        for k in 0..span.min(MAX_SPAN) {
             let i = centre - w + k as i64;
             if i >= 0 && (i as usize) < n {
                 let delta = i as f32 + 0.5 - frac;
-                a.h[k] = math::exp(-0.5 * loss * delta * delta);
-                a.id[k] = i as usize;
+                out.h[k] = math::exp(-0.5 * loss * delta * delta);
+                out.id[k] = i as usize;
             }
         }
-        a
+        out
     }
 
     /// Calls `f(index, h)` for the cells of the product of three axes' weights (range,
@@ -267,18 +365,18 @@ impl PointSpread {
         b: &AxisWeights,
         mut f: impl FnMut(usize, f32),
     ) {
-        let span = 2 * self.half_width.min(MAX_HALF_WIDTH) + 1;
-        for a in 0..span {
-            if r.id[a] == usize::MAX {
+        let sb = b.span.min(MAX_SPAN);
+        for (&ir, &hr) in r.id.iter().zip(&r.h).take(r.span) {
+            if ir == usize::MAX {
                 continue;
             }
-            for k in 0..span {
-                if d.id[k] == usize::MAX {
+            for (&jd, &hd) in d.id.iter().zip(&d.h).take(d.span) {
+                if jd == usize::MAX {
                     continue;
                 }
-                let hab = r.h[a] * d.h[k];
-                let base = (r.id[a] * g.n_doppler + d.id[k]) * g.n_azimuth;
-                for (&l, &h) in b.id[..span].iter().zip(&b.h[..span]) {
+                let hab = hr * hd;
+                let base = (ir * g.n_doppler + jd) * g.n_azimuth;
+                for (&l, &h) in b.id[..sb].iter().zip(&b.h[..sb]) {
                     if l != usize::MAX {
                         f(base + l, hab * h);
                     }
@@ -295,6 +393,8 @@ pub struct AxisWeights {
     h: [f32; MAX_SPAN],
     /// Cell index per slot, `usize::MAX` outside the axis.
     id: [usize; MAX_SPAN],
+    /// Slots in use, `2 w + 1`.
+    span: usize,
 }
 
 impl AxisWeights {
@@ -302,6 +402,7 @@ impl AxisWeights {
     pub const NONE: Self = Self {
         h: [0.0; MAX_SPAN],
         id: [usize::MAX; MAX_SPAN],
+        span: 0,
     };
 }
 
@@ -519,12 +620,7 @@ mod tests {
     #[test]
     fn spread_covers_neighbourhood_and_peaks_at_own_cell() {
         let g = geom();
-        let psf = PointSpread {
-            loss_range: 1.0,
-            loss_doppler: 1.0,
-            loss_azimuth: 1.0,
-            half_width: 1,
-        };
+        let psf = PointSpread::ONE_CELL;
         let c = RadarCoords {
             range: 90.0,
             doppler: 0.5,
@@ -559,5 +655,93 @@ mod tests {
         };
         psf.for_each_cell(&g, &far, |_, _| k += 1);
         assert_eq!(k, 0);
+    }
+
+    #[test]
+    fn spread_validation_bounds_the_cost_and_the_width() {
+        let ok = PointSpread::from_std([2.0, 2.0, 2.0], [6, 6, 6]);
+        assert_eq!(ok.covered(), 2197);
+        assert!(ok.validate().is_ok());
+        for bad in [
+            PointSpread {
+                half_width: [9, 0, 0],
+                ..ok
+            },
+            PointSpread {
+                half_width: [8, 8, 8],
+                ..ok
+            },
+            PointSpread::from_std([17.0, 1.0, 1.0], [1, 1, 1]),
+            PointSpread::from_std([0.0, 1.0, 1.0], [1, 1, 1]),
+            PointSpread {
+                loss_doppler: f32::NAN,
+                ..ok
+            },
+        ] {
+            assert!(bad.validate().is_err(), "{bad:?}");
+        }
+        assert_eq!(PointSpread::ONE_CELL.peak_radius(0), 1);
+        assert_eq!(ok.peak_radius(1), 2);
+        assert_eq!(PointSpread::from_std([0.5; 3], [1; 3]).peak_radius(2), 1);
+        assert_eq!(ok.central().half_width, [1, 1, 1]);
+    }
+
+    /// Per-axis half widths and losses against an f64 evaluation of eq. 3 at every
+    /// covered cell (tolerance: f32 rounding of `exp` of an argument up to ~50, relative
+    /// 1e-5), for the widest valid spreads; `log_lr` stays finite on a cube of large
+    /// powers at every position, in the cube or outside it.
+    #[test]
+    fn per_axis_spread_matches_eq3_and_log_lr_stays_finite() {
+        let g = CubeGeometry {
+            n_range: 30,
+            n_doppler: 20,
+            n_azimuth: 25,
+            ..geom()
+        };
+        let data: std::vec::Vec<f32> = (0..g.len()).map(|i| (i % 97) as f32 * 1e3).collect();
+        let cube = PowerCube::new(&data, g).unwrap();
+        for psf in [
+            PointSpread::from_std([2.0, 0.5, 16.0], [6, 1, 8]),
+            PointSpread::from_std([16.0, 16.0, 16.0], [6, 6, 6]),
+            PointSpread::from_std([0.0625, 1.0, 3.0], [0, 8, 3]),
+        ] {
+            psf.validate().unwrap();
+            let c = RadarCoords {
+                range: 310.0,
+                doppler: 4.3,
+                azimuth_deg: 11.7,
+            };
+            let (fr, fd, fb) = g.fractional(&c);
+            let mut n = 0;
+            psf.for_each_cell(&g, &c, |idx, h| {
+                let (i, j, l) = g.unindex(idx);
+                let d = |k: usize, f: f32| k as f64 + 0.5 - f as f64;
+                let want = (-0.5
+                    * (psf.loss_range as f64 * d(i, fr).powi(2)
+                        + psf.loss_doppler as f64 * d(j, fd).powi(2)
+                        + psf.loss_azimuth as f64 * d(l, fb).powi(2)))
+                .exp();
+                assert!((h as f64 - want).abs() <= 1e-5 * want + 1e-30, "{h} {want}");
+                n += 1;
+            });
+            let interior: usize = (0..3).map(|a| 2 * psf.half(a) + 1).product();
+            assert!(n <= interior && n > 0);
+            for (r, d, b) in [
+                (310.0, 4.3, 11.7),
+                (-1e30, 0.0, 0.0),
+                (1e6, -1e6, 1e6),
+                (f32::NAN, 0.0, 0.0),
+            ] {
+                let rc = RadarCoords {
+                    range: r,
+                    doppler: d,
+                    azimuth_deg: b,
+                };
+                for amp in [0.0, 1.0, 1e6] {
+                    let l = cube.log_lr(&psf, &rc, amp, 0.5);
+                    assert!(l.is_finite(), "{psf:?} {rc:?} {amp}: {l}");
+                }
+            }
+        }
     }
 }

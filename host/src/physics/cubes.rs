@@ -19,6 +19,17 @@
 //! S(u) = sin(pi u) / (pi u)   (S(0) = 1), zero beyond 8 cells from the target's cell
 //! ```
 //!
+//! With [`Response::Gaussian`] the factor of each axis is instead the separable point
+//! spread of Pei et al. (2019), eq. 3, in cell units,
+//!
+//! ```text
+//! G(u) = exp(-u^2 / (2 s^2)),   s the axis' standard deviation in cells
+//! ```
+//!
+//! (the paper's loss factor `L` over a cell of size `R` is `L = R / s^2`: eq. 3 writes
+//! `(r_i - r)^2 L_r / (2R)`), cut `ceil(6 s)` cells from the target's cell (beyond, the
+//! amplitude is below `exp(-18) = 1.5e-8` of the peak).
+//!
 //! `S` is the response of a resolution-limited axis sampled once per resolution cell
 //! (pulse compression in range, the coherent Doppler filter, the aperture in azimuth; the
 //! Dirichlet kernel of a long DFT is this sinc). `w` is complex white Gaussian, each of I
@@ -44,8 +55,62 @@ use faint_core::rng::Rng;
 
 use super::Swerling;
 
-/// Cells of the spread on each side of the target's cell.
+/// Cells of the sinc spread on each side of the target's cell.
 pub const REACH: isize = 8;
+
+/// Largest standard deviation (cells) of a [`Response::Gaussian`] axis.
+pub const MAX_GAUSSIAN_STD: f64 = 16.0;
+
+/// The response of every axis to a point target.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Response {
+    /// `S(u) = sin(pi u) / (pi u)` per axis, cut [`REACH`] cells from the target's cell.
+    Sinc,
+    /// Eq. 3 of Pei et al. (2019): `exp(-u^2 / (2 s^2))` per axis, `s` = `std` (cells;
+    /// range, Doppler, azimuth), cut `ceil(6 s)` cells from the target's cell.
+    Gaussian {
+        /// Standard deviation per axis (cells): range, Doppler, azimuth.
+        std: [f64; 3],
+    },
+}
+
+impl Response {
+    /// Parses `sinc` or `gauss:SR,SD,SB` (standard deviations in cells).
+    pub fn parse(s: &str) -> Result<Self> {
+        let s = s.trim();
+        if s == "sinc" {
+            return Ok(Self::Sinc);
+        }
+        let Some(list) = s.strip_prefix("gauss:") else {
+            anyhow::bail!("--cube-spread '{s}': must be 'sinc' or 'gauss:SR,SD,SB' (std in cells)");
+        };
+        let v: Vec<f64> = list
+            .split(',')
+            .map(|x| x.trim().parse::<f64>())
+            .collect::<std::result::Result<_, _>>()
+            .map_err(|_| anyhow::anyhow!("--cube-spread '{s}': the three stds must be numbers"))?;
+        let std: [f64; 3] = v.try_into().map_err(|_| {
+            anyhow::anyhow!("--cube-spread '{s}': give three stds (range, Doppler, azimuth)")
+        })?;
+        let r = Self::Gaussian { std };
+        r.validate()?;
+        Ok(r)
+    }
+
+    fn validate(&self) -> Result<()> {
+        if let Self::Gaussian { std } = self {
+            ensure!(
+                std.iter()
+                    .all(|s| s.is_finite() && *s > 0.0 && *s <= MAX_GAUSSIAN_STD),
+                "--cube-spread gauss:{},{},{}: each std must be in (0, {MAX_GAUSSIAN_STD}] cells",
+                std[0],
+                std[1],
+                std[2]
+            );
+        }
+        Ok(())
+    }
+}
 
 /// `sin(pi u) / (pi u)`, 1 at 0.
 pub fn sinc(u: f64) -> f64 {
@@ -84,16 +149,24 @@ impl Axis {
         v >= self.start && v < self.end()
     }
 
-    /// The cells `lo..hi` within [`REACH`] of the cell holding coordinate `u`, and their
-    /// factors `S(i - u)`.
-    fn spread(&self, u: f64) -> (usize, Vec<f64>) {
+    /// The cells `lo..hi` within the response's reach of the cell holding coordinate `u`,
+    /// and their factors: `S(i - u)` (`std = None`) or `exp(-(i - u)^2 / (2 std^2))`.
+    fn spread(&self, u: f64, std: Option<f64>) -> (usize, Vec<f64>) {
         let c = u.round() as isize;
-        let lo = (c - REACH).max(0);
-        let hi = (c + REACH + 1).min(self.n as isize);
+        let reach = std.map_or(REACH, |s| (6.0 * s).ceil() as isize);
+        let lo = (c - reach).max(0);
+        let hi = (c + reach + 1).min(self.n as isize);
         if lo >= hi {
             return (0, Vec::new());
         }
-        (lo as usize, (lo..hi).map(|i| sinc(i as f64 - u)).collect())
+        let f = |i: isize| {
+            let d = i as f64 - u;
+            match std {
+                None => sinc(d),
+                Some(s) => (-0.5 * d * d / (s * s)).exp(),
+            }
+        };
+        (lo as usize, (lo..hi).map(f).collect())
     }
 
     fn validate(&self, name: &str) -> Result<()> {
@@ -129,6 +202,8 @@ pub struct CubePhysics {
     pub speed: (f64, f64),
     /// Amplitude fluctuation.
     pub swerling: Swerling,
+    /// Response of each axis to the point target.
+    pub response: Response,
 }
 
 /// One simulated target's state at a frame.
@@ -146,7 +221,7 @@ pub struct CubeTruth {
 
 impl CubePhysics {
     /// Cube axes as given, `dt` 1 s, unit noise power, speed uniform in `[0, 50]` m/s,
-    /// Swerling 0.
+    /// Swerling 0, sinc response.
     pub fn new(range: Axis, doppler: Axis, azimuth: Axis) -> Self {
         Self {
             range,
@@ -156,6 +231,7 @@ impl CubePhysics {
             noise_power: 1.0,
             speed: (0.0, 50.0),
             swerling: Swerling::Zero,
+            response: Response::Sinc,
         }
     }
 
@@ -164,6 +240,7 @@ impl CubePhysics {
         self.range.validate("range")?;
         self.doppler.validate("doppler")?;
         self.azimuth.validate("azimuth")?;
+        self.response.validate()?;
         let cells = self.range.n * self.doppler.n * self.azimuth.n;
         ensure!(
             cells <= 1 << 28,
@@ -301,10 +378,14 @@ impl CubePhysics {
         // The echo's I and Q and its spread per axis (first cell, factors).
         let echo = echo.map(|(ak, q)| {
             let phi = 2.0 * std::f64::consts::PI * f64::from(rng.uniform());
+            let std = match self.response {
+                Response::Sinc => [None; 3],
+                Response::Gaussian { std } => std.map(Some),
+            };
             let s = [
-                self.range.spread(self.range.coord(q[0])),
-                self.doppler.spread(self.doppler.coord(q[1])),
-                self.azimuth.spread(self.azimuth.coord(q[2])),
+                self.range.spread(self.range.coord(q[0]), std[0]),
+                self.doppler.spread(self.doppler.coord(q[1]), std[1]),
+                self.azimuth.spread(self.azimuth.coord(q[2]), std[2]),
             ];
             (ak * phi.cos(), ak * phi.sin(), s)
         });

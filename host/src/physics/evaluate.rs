@@ -133,6 +133,11 @@ pub struct Args {
     /// Swerling case of the target's amplitude, 0, 1 or 3 (all but plots).
     #[arg(long, default_value_t = 0)]
     pub swerling: u8,
+    /// Response of the power cubes' axes to a point target: `sinc` (a resolution-limited
+    /// axis) or `gauss:SR,SD,SB`, the point spread of eq. 3 of Pei et al. (2019) with
+    /// these standard deviations in cells (range, Doppler, azimuth). Power cubes only.
+    #[arg(long, default_value = "sinc")]
+    pub cube_spread: String,
 }
 
 /// `--phase`.
@@ -304,10 +309,20 @@ pub fn run(a: &Args) -> Result<Evaluation> {
             };
         }
         Physics::Images(p) => p.swerling = swerling,
-        Physics::Cubes(p) => p.swerling = swerling,
+        Physics::Cubes(p) => {
+            p.swerling = swerling;
+            p.response = super::cubes::Response::parse(&a.cube_spread)?;
+        }
         Physics::Maps(p) => p.swerling = swerling,
         Physics::Plots(_) => {}
     }
+    ensure!(
+        a.cube_spread == "sinc" || matches!(phys, Physics::Cubes(_)),
+        "--cube-spread {}: only for power-cube detectors ({} reads {:?})",
+        a.cube_spread,
+        entry.name,
+        entry.input
+    );
     let l = match (a.frames, &phys) {
         (Some(l), _) => l,
         (None, Physics::Doppler(_)) => 20,
@@ -424,6 +439,9 @@ pub fn run(a: &Args) -> Result<Evaluation> {
     }
     if a.swerling != 0 {
         user_set.push_str(&format!(", --swerling {}", a.swerling));
+    }
+    if a.cube_spread != "sinc" {
+        user_set.push_str(&format!(", --cube-spread {}", a.cube_spread));
     }
     if a.burn_in > 0 {
         user_set.push_str(&format!(", --burn-in {}", a.burn_in));

@@ -197,7 +197,7 @@ impl SixTargets {
                 loss_range: 1.0,
                 loss_doppler: 1.0,
                 loss_azimuth: 1.0,
-                half_width: 1,
+                half_width: [1, 1, 1],
             },
         }
     }
@@ -230,7 +230,7 @@ impl SixTargets {
                 "azimuth_deg": [g.azimuth_start_deg, g.azimuth_start_deg + g.azimuth_cell_deg * g.n_azimuth as f32, g.azimuth_cell_deg],
                 "cells": g.len(),
             },
-            "point_spread": {"loss_cell_units": [1.0, 1.0, 1.0], "half_width_cells": 1},
+            "point_spread": {"loss_cell_units": [1.0, 1.0, 1.0], "half_width_cells": [1, 1, 1]},
             "birth_means": [[250.0, 0.0, 1500.0, 0.0], [1000.0, 0.0, 1000.0, 0.0], [1750.0, 0.0, 500.0, 0.0]],
             "birth_std": [20.0, 20.0, 20.0, 20.0],
             "birth_mode": "measurement-driven: 8 strongest cells per component window, tangential velocity N(0, 40^2), two-frame velocity off",

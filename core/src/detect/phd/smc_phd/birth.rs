@@ -226,48 +226,55 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
 
     /// [`BirthMode::Region`]: the `want` strongest local peaks of `sum h^2 z` (a target
     /// at the cell centre) over the whole cube, into the pooled birth-cell store. A cell
-    /// within one cell on every axis of a kept one replaces it if stronger, else is
-    /// skipped, so that one target's spread does not fill the store.
+    /// within [`PointSpread::peak_radius`] (the spread's standard deviation, at least one
+    /// cell) on every axis of a kept one replaces it if stronger, else is skipped, so
+    /// that one target's spread does not fill the store.
+    ///
+    /// The statistic covers [`PointSpread::central`] (27 cells at most per cell of the
+    /// cube, whatever the spread's half width).
     pub(super) fn choose_region_cells(&mut self, cube: &PowerCube<'_>, want: usize) {
         let g = self.cfg.geometry;
-        let psf = self.cfg.psf;
-        let w = psf.half_width.min(MAX_HALF_WIDTH);
-        let span = 2 * w + 1;
+        let rad = [
+            self.cfg.psf.peak_radius(0),
+            self.cfg.psf.peak_radius(1),
+            self.cfg.psf.peak_radius(2),
+        ];
+        let psf = self.cfg.psf.central();
+        let wa = [psf.half(0), psf.half(1), psf.half(2)];
         // Weights of a target at a cell centre, squared: `h^2 = exp(-L delta^2)`,
         // `delta = k - w` cells (the interior cells of `PointSpread::axis_weights`).
         let mut h2 = [[0.0f32; 2 * MAX_HALF_WIDTH + 1]; 3];
-        for (a, loss) in [psf.loss_range, psf.loss_doppler, psf.loss_azimuth]
-            .into_iter()
-            .enumerate()
-        {
-            for k in 0..span {
-                let dl = k as f32 - w as f32;
-                h2[a][k] = math::exp(-loss * dl * dl);
+        for (a, row) in h2.iter_mut().enumerate() {
+            let loss = psf.loss(a);
+            for (k, v) in row.iter_mut().enumerate().take(2 * wa[a] + 1) {
+                let dl = k as f32 - wa[a] as f32;
+                *v = math::exp(-loss * dl * dl);
             }
         }
+        let (w0, w1, w2) = (wa[0], wa[1], wa[2]);
         let data = cube.data();
         let out = self.birth_cells.as_flattened_mut();
         let want = want.min(out.len());
         let mut n = 0usize;
         // The weakest kept statistic once the store is full.
         let mut min = f32::NEG_INFINITY;
-        let near = |a: usize, b: usize| a.abs_diff(b) <= 1;
+        let near = |a: usize, b: usize, r: usize| a.abs_diff(b) <= r;
         for ir in 0..g.n_range {
             for jd in 0..g.n_doppler {
                 for lb in 0..g.n_azimuth {
                     let mut z = 0.0f32;
-                    for (a, &hr) in h2[0].iter().enumerate().take(span) {
-                        let Some(i) = (ir + a).checked_sub(w).filter(|&i| i < g.n_range) else {
+                    for (a, &hr) in h2[0].iter().enumerate().take(2 * w0 + 1) {
+                        let Some(i) = (ir + a).checked_sub(w0).filter(|&i| i < g.n_range) else {
                             continue;
                         };
-                        for (c, &hd) in h2[1].iter().enumerate().take(span) {
-                            let Some(j) = (jd + c).checked_sub(w).filter(|&j| j < g.n_doppler)
+                        for (c, &hd) in h2[1].iter().enumerate().take(2 * w1 + 1) {
+                            let Some(j) = (jd + c).checked_sub(w1).filter(|&j| j < g.n_doppler)
                             else {
                                 continue;
                             };
                             let base = (i * g.n_doppler + j) * g.n_azimuth;
-                            for (e, &hb) in h2[2].iter().enumerate().take(span) {
-                                let Some(l) = (lb + e).checked_sub(w).filter(|&l| l < g.n_azimuth)
+                            for (e, &hb) in h2[2].iter().enumerate().take(2 * w2 + 1) {
+                                let Some(l) = (lb + e).checked_sub(w2).filter(|&l| l < g.n_azimuth)
                                 else {
                                     continue;
                                 };
@@ -285,7 +292,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                     let kept = out.get_mut(..n).unwrap_or(&mut []);
                     if let Some(c) = kept.iter_mut().find(|c| {
                         let (pr, pd, pl) = g.unindex(c.0);
-                        near(pr, ir) && near(pd, jd) && near(pl, lb)
+                        near(pr, ir, rad[0]) && near(pd, jd, rad[1]) && near(pl, lb, rad[2])
                     }) {
                         if z > c.1 {
                             *c = (idx, z);
@@ -341,7 +348,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                 BirthMode::Measurement { cells: want, .. } => Self::strongest_in_window(
                     cube,
                     &g,
-                    &self.cfg.psf,
+                    &self.cfg.psf.central(),
                     &b.components[ci],
                     &mut self.birth_cells[ci][..want.min(MAX_BIRTH_CELLS)],
                 ),
@@ -400,20 +407,20 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         let cached = b1.saturating_sub(b0) <= AZ_CACHE;
         if cached {
             for (w, lb) in az.iter_mut().zip(b0..b1) {
-                *w = psf.axis_weights(frac(0, 0, lb).2, g.n_azimuth, psf.loss_azimuth);
+                *w = psf.axis_weights(2, frac(0, 0, lb).2, g.n_azimuth);
             }
         }
         for ir in r0..r1 {
-            let wr = psf.axis_weights(frac(ir, 0, 0).0, g.n_range, psf.loss_range);
+            let wr = psf.axis_weights(0, frac(ir, 0, 0).0, g.n_range);
             for jd in 0..g.n_doppler {
-                let wd = psf.axis_weights(frac(0, jd, 0).1, g.n_doppler, psf.loss_doppler);
+                let wd = psf.axis_weights(1, frac(0, jd, 0).1, g.n_doppler);
                 for lb in b0..b1 {
                     let idx = g.index(ir, jd, lb);
                     // Point-spread-matched statistic `sum h^2 z` of a target at the cell
                     // centre, as for the swarm's points.
                     let wb = match az.get(lb - b0) {
                         Some(w) if cached => *w,
-                        _ => psf.axis_weights(frac(0, 0, lb).2, g.n_azimuth, psf.loss_azimuth),
+                        _ => psf.axis_weights(2, frac(0, 0, lb).2, g.n_azimuth),
                     };
                     let mut z = 0.0f32;
                     psf.for_each_cell_of(g, &wr, &wd, &wb, |i, h| {

@@ -9,7 +9,14 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         let g = *cube.geometry();
         let data = cube.data();
         let want = want.min(M);
-        let psf = self.cfg.psf;
+        // The statistic over at most 3 x 3 x 3 cells (`PointSpread::central`), the
+        // thinning over the spread's own peak radius.
+        let rad = [
+            self.cfg.psf.peak_radius(0),
+            self.cfg.psf.peak_radius(1),
+            self.cfg.psf.peak_radius(2),
+        ];
+        let psf = self.cfg.psf.central();
         // (z, ir, lb, jd) sorted descending by z.
         let mut top = [(0.0f32, 0usize, 0usize, 0usize); M];
         let mut amp = [0.0f32; M];
@@ -50,8 +57,12 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             // (Table 1: three at (250, 1500), three at (1750, 500)) share range/azimuth
             // cells for several frames but not Doppler cells; thinning on position alone
             // left one point for two targets and the swarm merged their clouds.
+            // Within the spread's peak radius on every axis (one cell for a one-cell
+            // spread: 3 x 3 x 3 blocks).
             let near = |e: &(f32, usize, usize, usize)| {
-                e.1.abs_diff(ir) <= 1 && e.2.abs_diff(lb) <= 1 && e.3.abs_diff(jd) <= 1
+                e.1.abs_diff(ir) <= rad[0]
+                    && e.2.abs_diff(lb) <= rad[2]
+                    && e.3.abs_diff(jd) <= rad[1]
             };
             if top.iter().take(nt).any(|e| near(e) && e.0 >= z) {
                 continue;
