@@ -136,3 +136,20 @@ fn a_matched_spread_tracks_where_the_one_cell_response_does_not() {
         assert!(est <= RUNS, "noise: {est} estimates in {RUNS} runs");
     });
 }
+
+/// `half_width` reads as three numbers or, as configuration files written before the
+/// axes were separate, one number for all three; other lengths are refused.
+#[test]
+fn half_width_reads_one_number_or_three() {
+    use faint::core::model::power_cube::PointSpread;
+    let read = |w: &str| {
+        serde_json::from_str::<PointSpread>(&format!(
+            r#"{{"loss_range": 1.0, "loss_doppler": 1.0, "loss_azimuth": 1.0, "half_width": {w}}}"#
+        ))
+    };
+    assert_eq!(read("2").unwrap().half_width, [2, 2, 2]);
+    assert_eq!(read("[3, 1, 0]").unwrap().half_width, [3, 1, 0]);
+    for bad in ["[1, 1]", "[1, 1, 1, 1]", "-1", "1.5", "\"1\""] {
+        assert!(read(bad).is_err(), "{bad}");
+    }
+}

@@ -198,8 +198,52 @@ pub struct PointSpread {
     /// Azimuth loss `L_b = 1 / s_b^2` (cell units).
     pub loss_azimuth: f32,
     /// Cells covered on each side of the target's cell: range, Doppler, azimuth (each
-    /// `0..=8`, at most [`MAX_COVERED_CELLS`] cells in all).
+    /// `0..=8`, at most [`MAX_COVERED_CELLS`] cells in all). A configuration file may
+    /// give one number for all three axes (the form written before the axes were
+    /// separate).
+    #[cfg_attr(feature = "serde", serde(deserialize_with = "half_width_serde::deserialize"))]
     pub half_width: [usize; 3],
+}
+
+/// `half_width` as `[w_r, w_d, w_b]` or one number `w` meaning `[w, w, w]`.
+#[cfg(feature = "serde")]
+mod half_width_serde {
+    use core::fmt;
+    use serde::de::{Error, SeqAccess, Visitor};
+
+    struct HalfWidth;
+
+    impl<'de> Visitor<'de> for HalfWidth {
+        type Value = [usize; 3];
+
+        fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+            f.write_str("a half width (cells) or three: [range, doppler, azimuth]")
+        }
+
+        fn visit_u64<E: Error>(self, v: u64) -> Result<[usize; 3], E> {
+            let w = usize::try_from(v).map_err(|_| E::custom("half width out of range"))?;
+            Ok([w; 3])
+        }
+
+        fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<[usize; 3], A::Error> {
+            let mut out = [0usize; 3];
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = seq
+                    .next_element()?
+                    .ok_or_else(|| A::Error::invalid_length(i, &self))?;
+            }
+            if seq.next_element::<usize>()?.is_some() {
+                return Err(A::Error::invalid_length(4, &self));
+            }
+            Ok(out)
+        }
+    }
+
+    pub(super) fn deserialize<'de, D: serde::Deserializer<'de>>(
+        d: D,
+    ) -> Result<[usize; 3], D::Error> {
+        d.deserialize_any(HalfWidth)
+    }
 }
 
 /// Largest supported half width of one axis of a [`PointSpread`].
