@@ -51,6 +51,7 @@ fn false_alarm_rate(cal: &Calibration, input: &Path, runs: usize, l: usize) -> f
         seed: 99,
         reports: false,
         restart_every: Some(l),
+        runs: None,
     })
     .unwrap();
     let mut declared = vec![false; runs * l];

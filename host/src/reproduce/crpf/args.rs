@@ -7,12 +7,15 @@ use anyhow::{ensure, Result};
 
 use super::evaluation::{ComparatorModel, Likelihood, VarSource};
 use crate::cli;
+use crate::shard::ShardArg;
+use serde::{Deserialize, Serialize};
 use crate::scenario::crpf::{Noise, Othr};
 use faint_core::detect::pf_tbd::BirthProposal;
 use faint_core::model::doppler::Window;
 
 /// Analysis window of the scene and every detector's model (`--window`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
 pub enum SceneWindow {
     /// Symmetric Hamming (the preset; neighbouring bins correlated).
     #[default]
@@ -31,8 +34,9 @@ impl From<SceneWindow> for Window {
 }
 
 /// Command-line arguments of `faint reproduce crpf`. `--quick` changes the defaults of
-/// the arguments not given, never a given value.
-#[derive(clap::Args, Debug, Clone)]
+/// the arguments not given, never a given value. Shard files keep them as JSON
+/// (without `--shard`).
+#[derive(clap::Args, Debug, Clone, Serialize, Deserialize)]
 pub struct Args {
     /// Particles per detector: 100, 250, 500, 1000, 2000, 4000 or 6000 [default: 1000;
     /// --quick: 100].
@@ -94,6 +98,10 @@ pub struct Args {
     /// SNR 0:16:4, sweeps with 200 + 40 runs; never overrides a value given.
     #[arg(long)]
     pub quick: bool,
+    /// One shard of the runs (`--shard I/N`, see `faint merge`).
+    #[command(flatten)]
+    #[serde(skip)]
+    pub shard: ShardArg,
 }
 
 /// The arguments after the `--quick` defaults, checked.
