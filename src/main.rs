@@ -224,7 +224,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 crpf::COMMAND => crpf::merge(&m, out.as_deref())?,
                 calibrate::COMMAND => {
                     let cal = calibrate::merge(&m, out.as_deref())?;
-                    let args: calibrate::Args = serde_json::from_str(&m.run.args)?;
+                    let args: calibrate::Args = m.run.args()?;
                     print_calibration(&cal, out.as_deref().unwrap_or(&args.out));
                 }
                 other => anyhow::bail!(
@@ -232,10 +232,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     m.files[0].display()
                 ),
             }
-            println!(
-                "merged {} shards of `faint {}`",
-                m.count, m.run.command
-            );
+            println!("merged {} shards of `faint {}`", m.count, m.run.command);
             Ok(())
         }
         Command::Evaluate(a) => {

@@ -165,12 +165,7 @@ impl Shard {
     /// so the names sort in index order).
     pub fn file_name(&self) -> String {
         let w = self.count.to_string().len();
-        format!(
-            "shard-{:0w$}-of-{}.{EXT}",
-            self.index,
-            self.count,
-            w = w
-        )
+        format!("shard-{:0w$}-of-{}.{EXT}", self.index, self.count, w = w)
     }
 }
 
@@ -209,27 +204,55 @@ impl<T> Batch<T> {
 }
 
 /// What makes shards parts of one run: the command, its arguments and the inputs fixed
-/// before the trials.
+/// before the trials. The arguments and inputs are kept as CBOR, whose floats
+/// round-trip exactly (JSON text would not promise it).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Run {
     /// The command, as typed (`reproduce crpf`, `calibrate`).
     pub command: String,
-    /// Its arguments as a JSON object (every option, given or default; `--shard` left
-    /// out).
-    pub args: String,
-    /// JSON of what the command fixed before the trials (for example a noise model
-    /// estimated on the input), identical in every shard; `null` if nothing.
-    pub meta: String,
+    /// Its arguments (every option, given or default; `--shard` left out), CBOR.
+    args: Vec<u8>,
+    /// What the command fixed before the trials (for example a noise model estimated on
+    /// the input), identical in every shard; CBOR, `null` if nothing.
+    meta: Vec<u8>,
+}
+
+fn cbor(v: &impl Serialize) -> Result<Vec<u8>> {
+    let mut buf = Vec::new();
+    ciborium::into_writer(v, &mut buf).map_err(|e| anyhow::anyhow!("cannot encode: {e}"))?;
+    Ok(buf)
+}
+
+fn uncbor<T: DeserializeOwned>(bytes: &[u8], what: &str) -> Result<T> {
+    ciborium::from_reader(bytes).map_err(|e| anyhow::anyhow!("unreadable {what}: {e}"))
 }
 
 impl Run {
-    /// A run of `command` with arguments `args` (serialised to JSON) and no meta.
+    /// A run of `command` with arguments `args` and no meta.
     pub fn new(command: &str, args: &impl Serialize) -> Result<Self> {
         Ok(Self {
             command: command.to_string(),
-            args: serde_json::to_string(args)?,
-            meta: "null".into(),
+            args: cbor(args)?,
+            meta: cbor(&())?,
         })
+    }
+
+    /// The run with `meta`, the inputs it fixed before the trials.
+    pub fn with_meta(self, meta: &impl Serialize) -> Result<Self> {
+        Ok(Self {
+            meta: cbor(meta)?,
+            ..self
+        })
+    }
+
+    /// The arguments, decoded.
+    pub fn args<T: DeserializeOwned>(&self) -> Result<T> {
+        uncbor(&self.args, "arguments")
+    }
+
+    /// The meta, decoded.
+    pub fn meta<T: DeserializeOwned>(&self) -> Result<T> {
+        uncbor(&self.meta, "inputs")
     }
 }
 
@@ -389,11 +412,11 @@ fn load(path: &Path) -> Result<File<ciborium::Value>> {
         .map_err(|e| anyhow::anyhow!("{}: a damaged shard file ({e})", path.display()))
 }
 
-/// The first option whose value differs between two argument sets (JSON objects), as
-/// `--name: A here, B in REF`.
-fn first_difference(a: &str, b: &str) -> String {
-    let parse = |s: &str| -> BTreeMap<String, serde_json::Value> {
-        serde_json::from_str(s).unwrap_or_default()
+/// The first option whose value differs between two argument sets (CBOR maps), as
+/// `--name A here, B`.
+fn first_difference(a: &[u8], b: &[u8]) -> String {
+    let parse = |s: &[u8]| -> BTreeMap<String, serde_json::Value> {
+        uncbor(s, "arguments").unwrap_or_default()
     };
     let (a, b) = (parse(a), parse(b));
     let keys: std::collections::BTreeSet<&String> = a.keys().chain(b.keys()).collect();
@@ -484,7 +507,11 @@ pub fn read(inputs: &[PathBuf]) -> Result<Merged> {
         .collect();
     if !missing.is_empty() {
         let list = if missing.len() > 4 {
-            format!("{}, ... ({} in all)", missing[..4].join(", "), missing.len())
+            format!(
+                "{}, ... ({} in all)",
+                missing[..4].join(", "),
+                missing.len()
+            )
         } else {
             missing.join(", ")
         };
@@ -523,12 +550,13 @@ pub fn read(inputs: &[PathBuf]) -> Result<Merged> {
             p.display(),
             loaded_name(&paths, order[0])
         );
-        for (b, j) in std::mem::take(&mut f.batches).into_iter().zip(joined.iter_mut()) {
+        for (b, j) in std::mem::take(&mut f.batches)
+            .into_iter()
+            .zip(joined.iter_mut())
+        {
             let want = shard.range(j.trials);
             ensure!(
-                b.trials == j.trials
-                    && b.first == want.start
-                    && b.results.len() == want.len(),
+                b.trials == j.trials && b.first == want.start && b.results.len() == want.len(),
                 "{}: batch {} holds trials {}..{} of {}, shard {shard} must hold {}..{} of {}",
                 p.display(),
                 b.key,
@@ -579,20 +607,38 @@ mod tests {
     fn parses_and_rejects() {
         assert_eq!(Shard::parse("2/8").unwrap(), Shard { index: 2, count: 8 });
         for (s, msg) in [
-            ("8/8", "--shard 8/8: shard 8 of 8 does not exist (shards are 0..7)"),
-            ("1/0", "--shard 1/0: the shard count must lie in 1..=100000, got 0"),
+            (
+                "8/8",
+                "--shard 8/8: shard 8 of 8 does not exist (shards are 0..7)",
+            ),
+            (
+                "1/0",
+                "--shard 1/0: the shard count must lie in 1..=100000, got 0",
+            ),
             ("a/4", "--shard a/4: 'a' is not a whole number"),
             ("3", "--shard 3: not I/N (for example 0/4) or off"),
         ] {
             assert_eq!(Shard::parse(s).unwrap_err().to_string(), msg);
         }
-        assert_eq!(ShardArg { shard: Some("off".into()) }.resolve().unwrap(), None);
+        assert_eq!(
+            ShardArg {
+                shard: Some("off".into())
+            }
+            .resolve()
+            .unwrap(),
+            None
+        );
     }
 
     #[test]
     fn scheduler_environments() {
         let env = |pairs: &'static [(&'static str, &'static str)]| {
-            move |k: &str| pairs.iter().find(|(n, _)| *n == k).map(|(_, v)| v.to_string())
+            move |k: &str| {
+                pairs
+                    .iter()
+                    .find(|(n, _)| *n == k)
+                    .map(|(_, v)| v.to_string())
+            }
         };
         assert_eq!(Shard::from_env(env(&[])).unwrap(), None);
         let s = Shard::from_env(env(&[
@@ -609,7 +655,10 @@ mod tests {
         ]));
         assert_eq!(s.unwrap(), Some(Shard { index: 3, count: 4 }));
         let e = Shard::from_env(env(&[("SLURM_ARRAY_TASK_ID", "4")])).unwrap_err();
-        assert!(e.to_string().contains("SLURM_ARRAY_TASK_COUNT is not"), "{e}");
+        assert!(
+            e.to_string().contains("SLURM_ARRAY_TASK_COUNT is not"),
+            "{e}"
+        );
         let e = Shard::from_env(env(&[
             ("SLURM_ARRAY_TASK_ID", "4"),
             ("SLURM_ARRAY_TASK_COUNT", "4"),
@@ -668,14 +717,17 @@ mod tests {
         let run = Run::new("test", &serde_json::json!({"trials": 4, "seed": 1})).unwrap();
         let put = |dir: &Path, run: &Run, index: usize, count: usize| {
             let shard = Shard { index, count };
-            let b = Batch::run("a", 4, Some(shard), |r| Ok::<_, ()>(r.collect::<Vec<_>>()))
-                .unwrap();
+            let b =
+                Batch::run("a", 4, Some(shard), |r| Ok::<_, ()>(r.collect::<Vec<_>>())).unwrap();
             write(dir, run, shard, &[b]).unwrap()
         };
         put(&dir, &run, 0, 2);
         let e = read(std::slice::from_ref(&dir)).unwrap_err().to_string();
         assert!(e.starts_with("shard 1/2 is missing from"), "{e}");
-        assert!(e.ends_with("(1 of the 2 shards of `faint test` found)"), "{e}");
+        assert!(
+            e.ends_with("(1 of the 2 shards of `faint test` found)"),
+            "{e}"
+        );
         assert!(!e.contains('\n'));
         let other = temp("bad-copy");
         let p1 = put(&other, &run, 1, 2);
@@ -688,7 +740,10 @@ mod tests {
         let foreign = Run::new("test", &serde_json::json!({"trials": 4, "seed": 2})).unwrap();
         let f = put(&temp("bad-foreign"), &foreign, 1, 2);
         let e = read(&[dir.clone(), f]).unwrap_err().to_string();
-        assert!(e.contains("a shard of another run (--seed 2 here, 1 in"), "{e}");
+        assert!(
+            e.contains("a shard of another run (--seed 2 here, 1 in"),
+            "{e}"
+        );
         let f = put(&temp("bad-count"), &run, 1, 3);
         let e = read(&[dir.clone(), f]).unwrap_err().to_string();
         assert!(e.contains("shard 1/3, but"), "{e}");
@@ -697,7 +752,14 @@ mod tests {
         std::fs::write(junk.join("x.faint-shard"), b"hello").unwrap();
         let e = read(&[junk.clone()]).unwrap_err().to_string();
         assert!(e.ends_with("x.faint-shard: not a faint shard file"), "{e}");
-        for d in ["bad", "bad-copy", "bad-dup", "bad-foreign", "bad-count", "bad-junk"] {
+        for d in [
+            "bad",
+            "bad-copy",
+            "bad-dup",
+            "bad-foreign",
+            "bad-count",
+            "bad-junk",
+        ] {
             let _ = std::fs::remove_dir_all(temp(d));
         }
     }

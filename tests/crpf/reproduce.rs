@@ -27,6 +27,7 @@ fn quick_reproduction_writes_every_output() {
         window: Default::default(),
         birth_proposal: "exact".into(),
         quick: true,
+        shard: Default::default(),
     };
     run(&args).unwrap();
     let d = out.join("cgg_n100");

@@ -107,10 +107,7 @@ pub fn run(a: &Args) -> Result<Calibration> {
 /// returns the shard file.
 pub fn run_shard(a: &Args, shard: Shard) -> Result<std::path::PathBuf> {
     let (meta, batches) = scores(a, Some(shard))?;
-    let run = Run {
-        meta: serde_json::to_string(&meta)?,
-        ..Run::new(COMMAND, a)?
-    };
+    let run = Run::new(COMMAND, a)?.with_meta(&meta)?;
     shard::write(&shard_dir(&a.out), &run, shard, &batches)
 }
 
@@ -125,11 +122,11 @@ pub fn shard_dir(out: &Path) -> std::path::PathBuf {
 /// `faint merge` of `calibrate` shards: the calibration of the whole run, written to
 /// `out` if given, else to the run's `--out`.
 pub fn merge(m: &Merged, out: Option<&Path>) -> Result<Calibration> {
-    let mut a: Args = serde_json::from_str(&m.run.args)?;
+    let mut a: Args = m.run.args()?;
     if let Some(o) = out {
         a.out = o.to_path_buf();
     }
-    let meta: Meta = serde_json::from_str(&m.run.meta)?;
+    let meta: Meta = m.run.meta()?;
     let s = m.results::<Vec<f64>>(&["runs".to_string()])?;
     finish(&a, meta, s.into_iter().next().unwrap_or_default())
 }

@@ -7,11 +7,11 @@ use anyhow::{ensure, Result};
 
 use super::evaluation::{ComparatorModel, Likelihood, VarSource};
 use crate::cli;
-use crate::shard::ShardArg;
-use serde::{Deserialize, Serialize};
 use crate::scenario::crpf::{Noise, Othr};
+use crate::shard::ShardArg;
 use faint_core::detect::pf_tbd::BirthProposal;
 use faint_core::model::doppler::Window;
+use serde::{Deserialize, Serialize};
 
 /// Analysis window of the scene and every detector's model (`--window`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]

@@ -31,8 +31,8 @@ use args::Settings;
 pub use args::{Args, SceneWindow, PARTICLES};
 pub use calibration::calibration;
 pub use evaluation::{
-    batch, batch_range, run_detector, run_stats, ComparatorModel, Comparators, Likelihood, Stats, VarSource,
-    METHODS,
+    batch, batch_range, run_detector, run_stats, ComparatorModel, Comparators, Likelihood, Stats,
+    VarSource, METHODS,
 };
 
 /// One Monte Carlo batch of the reproduction: its key in shard files, its runs and how
@@ -204,7 +204,7 @@ pub fn run(args: &Args) -> Result<()> {
 /// `faint merge` of `reproduce crpf` shards: the outputs of the unsharded run, written
 /// where it writes them (under `out` if given, else the run's `--out`).
 pub fn merge(m: &Merged, out: Option<&Path>) -> Result<()> {
-    let mut args: Args = serde_json::from_str(&m.run.args)?;
+    let mut args: Args = m.run.args()?;
     if let Some(o) = out {
         args.out = o.to_path_buf();
     }
