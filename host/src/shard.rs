@@ -263,6 +263,8 @@ struct Header {
     version: String,
     run: Run,
     shard: Shard,
+    /// Wall-clock seconds the shard's runs took.
+    seconds: f64,
 }
 
 #[derive(Debug, Serialize)]
@@ -277,13 +279,14 @@ struct File<T> {
     batches: Vec<Batch<T>>,
 }
 
-/// Writes the batches of `shard` of `run` into `dir` (created) as
-/// [`Shard::file_name`]; returns the file's path. The file is written under a temporary
+/// Writes the batches of `shard` of `run`, which took `seconds` of wall-clock time, into
+/// `dir` (created) as [`Shard::file_name`]; returns the file's path. The file is written under a temporary
 /// name and renamed, so a reader never sees half of it.
 pub fn write<T: Serialize>(
     dir: &Path,
     run: &Run,
     shard: Shard,
+    seconds: f64,
     batches: &[Batch<T>],
 ) -> Result<PathBuf> {
     std::fs::create_dir_all(dir)
@@ -297,6 +300,7 @@ pub fn write<T: Serialize>(
             version: VERSION.into(),
             run: run.clone(),
             shard,
+            seconds,
         },
         batches,
     };
@@ -317,6 +321,8 @@ pub struct Merged {
     pub count: usize,
     /// Files merged, in shard order.
     pub files: Vec<PathBuf>,
+    /// Sum of the shards' wall-clock seconds.
+    pub seconds: f64,
     batches: Vec<Batch<ciborium::Value>>,
 }
 
@@ -528,6 +534,7 @@ pub fn read(inputs: &[PathBuf]) -> Result<Merged> {
     let order: Vec<usize> = by_index.into_iter().flatten().collect();
     let mut joined: Vec<Batch<ciborium::Value>> = Vec::new();
     let mut files = Vec::with_capacity(count);
+    let mut seconds = 0.0;
     for (i, &n) in order.iter().enumerate() {
         let (p, f) = &mut loaded[n];
         let shard = f.header.shard;
@@ -570,11 +577,13 @@ pub fn read(inputs: &[PathBuf]) -> Result<Merged> {
             j.results.extend(b.results);
         }
         files.push(p.clone());
+        seconds += f.header.seconds;
     }
     Ok(Merged {
         run,
         count,
         files,
+        seconds,
         batches: joined,
     })
 }
@@ -699,10 +708,11 @@ mod tests {
                 Ok::<_, ()>(r.map(value).collect::<Vec<f64>>())
             })
             .unwrap();
-            write(&dir, &run, shard, &[b]).unwrap();
+            write(&dir, &run, shard, 1.0, &[b]).unwrap();
         }
         let m = read(std::slice::from_ref(&dir)).unwrap();
         assert_eq!(m.count, 3);
+        assert_eq!(m.seconds, 3.0);
         let r: Vec<Vec<f64>> = m.results(&["a".to_string()]).unwrap();
         let bits: Vec<u64> = r[0].iter().map(|x| x.to_bits()).collect();
         let want: Vec<u64> = (0..7).map(|t| value(t).to_bits()).collect();
@@ -719,7 +729,7 @@ mod tests {
             let shard = Shard { index, count };
             let b =
                 Batch::run("a", 4, Some(shard), |r| Ok::<_, ()>(r.collect::<Vec<_>>())).unwrap();
-            write(dir, run, shard, &[b]).unwrap()
+            write(dir, run, shard, 1.0, &[b]).unwrap()
         };
         put(&dir, &run, 0, 2);
         let e = read(std::slice::from_ref(&dir)).unwrap_err().to_string();

@@ -106,9 +106,11 @@ pub fn run(a: &Args) -> Result<Calibration> {
 /// shard's noise runs and writes their scores to `<out stem>.shards/` for `faint merge`;
 /// returns the shard file.
 pub fn run_shard(a: &Args, shard: Shard) -> Result<std::path::PathBuf> {
+    let t0 = std::time::Instant::now();
     let (meta, batches) = scores(a, Some(shard))?;
     let run = Run::new(COMMAND, a)?.with_meta(&meta)?;
-    shard::write(&shard_dir(&a.out), &run, shard, &batches)
+    let seconds = t0.elapsed().as_secs_f64();
+    shard::write(&shard_dir(&a.out), &run, shard, seconds, &batches)
 }
 
 /// The shard folder of a calibration written to `out`: `<out without .json>.shards`.

@@ -131,8 +131,9 @@ fn collect(a: &Settings, shard: Option<Shard>) -> Result<Vec<Batch<Stats>>> {
         .collect()
 }
 
-/// The outputs of the run from every batch's runs (in [`specs`] order).
-fn analyse(a: &Settings, mut runs: Vec<Vec<Stats>>, t0: std::time::Instant) -> Result<()> {
+/// The outputs of the run from every batch's runs (in [`specs`] order); `seconds` gives
+/// the run time `table.md` states (for merged shards, the sum of theirs).
+fn analyse(a: &Settings, mut runs: Vec<Vec<Stats>>, seconds: impl Fn() -> f64) -> Result<()> {
     let (_, cfg) = scene(a);
     let dir = a.out.join(a.tag());
     crate::cli::out_dir(&dir)?;
@@ -151,14 +152,7 @@ fn analyse(a: &Settings, mut runs: Vec<Vec<Stats>>, t0: std::time::Instant) -> R
 
     // Table: SNR at Pd = 0.5 and 0.9.
     let snr_rows = evaluation::snr_at_pd_rows(a, &pd.curves);
-    let md = figures::table(
-        &dir,
-        a,
-        &snr_rows,
-        &th,
-        &pd.fd_err,
-        t0.elapsed().as_secs_f64(),
-    )?;
+    let md = figures::table(&dir, a, &snr_rows, &th, &pd.fd_err, seconds())?;
 
     if a.sweeps {
         let mut pairs = Vec::new();
@@ -185,14 +179,16 @@ pub fn run(args: &Args) -> Result<()> {
     let t0 = std::time::Instant::now();
     let batches = collect(&a, shard)?;
     match shard {
-        None => analyse(&a, batches.into_iter().map(|b| b.results).collect(), t0),
+        None => analyse(&a, batches.into_iter().map(|b| b.results).collect(), || {
+            t0.elapsed().as_secs_f64()
+        }),
         Some(s) => {
             let dir = a.out.join(a.tag()).join("shards");
-            let path = shard::write(&dir, &Run::new(COMMAND, args)?, s, &batches)?;
+            let seconds = t0.elapsed().as_secs_f64();
+            let path = shard::write(&dir, &Run::new(COMMAND, args)?, s, seconds, &batches)?;
             let runs: usize = batches.iter().map(|b| b.results.len()).sum();
             println!(
-                "shard {s}: {runs} runs in {:.1} s written to {}; merge with `faint merge {}`",
-                t0.elapsed().as_secs_f64(),
+                "shard {s}: {runs} runs in {seconds:.1} s written to {}; merge with `faint merge {}`",
                 path.display(),
                 dir.display()
             );
@@ -211,5 +207,5 @@ pub fn merge(m: &Merged, out: Option<&Path>) -> Result<()> {
     let a = args.effective()?;
     let (sc, cfg) = scene(&a);
     let keys: Vec<String> = specs(&a, &sc, &cfg).into_iter().map(|s| s.key).collect();
-    analyse(&a, m.results(&keys)?, std::time::Instant::now())
+    analyse(&a, m.results(&keys)?, || m.seconds)
 }
