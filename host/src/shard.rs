@@ -760,7 +760,7 @@ mod tests {
         let junk = temp("bad-junk");
         std::fs::create_dir_all(&junk).unwrap();
         std::fs::write(junk.join("x.faint-shard"), b"hello").unwrap();
-        let e = read(&[junk.clone()]).unwrap_err().to_string();
+        let e = read(std::slice::from_ref(&junk)).unwrap_err().to_string();
         assert!(e.ends_with("x.faint-shard: not a faint shard file"), "{e}");
         for d in [
             "bad",
