@@ -5,7 +5,7 @@
 //! batch always draws from `Rng::from_stream(master, t)` ([`crate::montecarlo`]), so it
 //! gives the same result whichever process runs it. Shard `i` of `n` runs trials
 //! `floor(t i / n) .. floor(t (i + 1) / n)` of every batch ([`Shard::range`]) and writes
-//! their raw results to a shard file ([`write`]): CBOR, whose floats round-trip bit for
+//! their raw results to a shard file ([`write()`]): CBOR, whose floats round-trip bit for
 //! bit (NaN and infinities included), with the command, its full argument set, the run's
 //! fixed inputs (`meta`), the binary's version and the format version. [`read`] checks
 //! that a set of shard files is one whole run (one command, arguments, inputs and
