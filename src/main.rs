@@ -41,10 +41,25 @@ enum Command {
     Simulate(SimulateArgs),
     /// Thresholds at a false-alarm probability for a detector, from noise-only data or
     /// from a noise model estimated on a recording (for `faint detect --calibration`).
-    Calibrate(faint::host::calibrate::Args),
+    Calibrate {
+        #[command(flatten)]
+        args: faint::host::calibrate::Args,
+        #[command(flatten)]
+        shard: faint::host::shard::ShardArg,
+    },
     /// One detector on data from the physics simulator of its input kind: calibrated
     /// Pfa measured, Pd against SNR, the SNR at Pd 0.9 (one Markdown table row).
     Evaluate(faint::host::physics::evaluate::Args),
+    /// Join the shard files of a `--shard I/N` run (folders or files) into the outputs of
+    /// the unsharded run, after checking they are every shard of one run.
+    Merge {
+        /// Shard files, or folders whose *.faint-shard files are read.
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+        /// Write the outputs here instead of the run's --out.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Drive detectors with mutated configurations and hostile frames; write the findings.
     Fuzz(faint::host::reliability::cli::FuzzArgs),
     /// Stream plausible frames through detectors without reset; report cost drift and memory.
@@ -185,34 +200,39 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             );
             Ok(())
         }
-        Command::Calibrate(a) => {
-            let cal = faint::host::calibrate::run(&a)?;
-            let values: Vec<f32> = cal.thresholds.iter().filter_map(|t| t.value).collect();
-            let lo = values.iter().copied().fold(f32::INFINITY, f32::min);
-            let hi = values.iter().copied().fold(f32::NEG_INFINITY, f32::max);
-            println!(
-                "{}: Pfa {} per frame from frame {} to {}: {} noise runs of {} frames; {} thresholds on the {} score{}; written to {}",
-                cal.detector,
-                cal.pfa,
-                cal.burn_in,
-                cal.run_frames - 1,
-                cal.runs,
-                cal.run_frames,
-                cal.thresholds.len(),
-                cal.score,
-                if values.is_empty() {
-                    " (every one minus infinity: the noise reported nothing)".to_string()
-                } else {
-                    format!(" in [{lo}, {hi}]")
-                },
-                a.out.display()
-            );
-            if let Some(got) = cal.achieved_pfa().filter(|&g| g < 0.5 * cal.pfa) {
+        Command::Calibrate { args: a, shard } => match shard.resolve()? {
+            Some(s) => {
+                let path = faint::host::calibrate::run_shard(&a, s)?;
                 println!(
-                    "{}: note: the {} score is discrete and ties at the thresholds: they achieve Pfa {got:.4} on the noise runs (mean over frames), below the {} asked",
-                    cal.detector, cal.score, cal.pfa
+                    "{}: shard {s} written to {}; merge with `faint merge {}`",
+                    a.detector,
+                    path.display(),
+                    faint::host::calibrate::shard_dir(&a.out).display()
                 );
+                Ok(())
             }
+            None => {
+                let cal = faint::host::calibrate::run(&a)?;
+                print_calibration(&cal, &a.out);
+                Ok(())
+            }
+        },
+        Command::Merge { inputs, out } => {
+            use faint::host::{calibrate, reproduce::crpf};
+            let m = faint::host::shard::read(&inputs)?;
+            match m.run.command.as_str() {
+                crpf::COMMAND => crpf::merge(&m, out.as_deref())?,
+                calibrate::COMMAND => {
+                    let cal = calibrate::merge(&m, out.as_deref())?;
+                    let args: calibrate::Args = m.run.args()?;
+                    print_calibration(&cal, out.as_deref().unwrap_or(&args.out));
+                }
+                other => anyhow::bail!(
+                    "{}: shards of `faint {other}`, which this faint cannot merge",
+                    m.files[0].display()
+                ),
+            }
+            println!("merged {} shards of `faint {}`", m.count, m.run.command);
             Ok(())
         }
         Command::Evaluate(a) => {
@@ -243,6 +263,36 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             Reproduce::Cbmember(a) => faint::host::reproduce::cbmember::run(&a),
             Reproduce::Dp(a) => faint::host::reproduce::dp::run(&a),
         },
+    }
+}
+
+/// The summary lines of a calibration written to `out`.
+fn print_calibration(cal: &faint::host::detect::calibration::Calibration, out: &std::path::Path) {
+    let values: Vec<f32> = cal.thresholds.iter().filter_map(|t| t.value).collect();
+    let lo = values.iter().copied().fold(f32::INFINITY, f32::min);
+    let hi = values.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+    println!(
+        "{}: Pfa {} per frame from frame {} to {}: {} noise runs of {} frames; {} thresholds on the {} score{}; written to {}",
+        cal.detector,
+        cal.pfa,
+        cal.burn_in,
+        cal.run_frames - 1,
+        cal.runs,
+        cal.run_frames,
+        cal.thresholds.len(),
+        cal.score,
+        if values.is_empty() {
+            " (every one minus infinity: the noise reported nothing)".to_string()
+        } else {
+            format!(" in [{lo}, {hi}]")
+        },
+        out.display()
+    );
+    if let Some(got) = cal.achieved_pfa().filter(|&g| g < 0.5 * cal.pfa) {
+        println!(
+            "{}: note: the {} score is discrete and ties at the thresholds: they achieve Pfa {got:.4} on the noise runs (mean over frames), below the {} asked",
+            cal.detector, cal.score, cal.pfa
+        );
     }
 }
 
@@ -292,6 +342,7 @@ fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
         seed: a.seed,
         reports: a.reports,
         restart_every: None,
+        runs: None,
     };
     let outcome = (entry.run)(&req)?;
     if let Some(cal) = &calibration {

@@ -4,6 +4,8 @@
 //! `scenario -> frames -> detector (faint-core) -> report -> statistics`.
 //!
 //! - [`montecarlo`]: parallel trials with per-trial seeds, identical for any thread count.
+//! - [`shard`]: a run's trials split into shards (`--shard i/n`, SLURM and Kubernetes
+//!   arrays) and merged bit for bit (`faint merge`).
 //! - [`stats`]: thresholds at a false-alarm rate, detection rates with confidence
 //!   intervals, Pd-versus-SNR crossings, ROC, OSPA, GOSPA.
 //! - [`io`]: CSV, JSON, Markdown tables and SVG plots; recorded frames and plot lists
@@ -30,6 +32,7 @@ pub mod physics;
 pub mod reliability;
 pub mod reproduce;
 pub mod scenario;
+pub mod shard;
 pub mod simulate;
 pub mod stats;
 pub mod timing;

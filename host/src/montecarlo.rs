@@ -113,9 +113,26 @@ where
     T: Send,
     F: Fn(usize, &mut Rng) -> T + Sync,
 {
-    let pb = progress_bar(label, trials);
+    run_trial_range(master_seed, 0..trials, label, f)
+}
+
+/// [`run_trials`] for the trials `range` only (one shard of a run, [`crate::shard`]):
+/// trial `i` still gets `Rng::from_stream(master_seed, i)`, so its result is the one the
+/// whole run computes.
+pub fn run_trial_range<T, F>(
+    master_seed: u64,
+    range: std::ops::Range<usize>,
+    label: &str,
+    f: F,
+) -> Vec<T>
+where
+    T: Send,
+    F: Fn(usize, &mut Rng) -> T + Sync,
+{
+    let pb = progress_bar(label, range.len());
     let go = || -> Vec<T> {
-        (0..trials)
+        range
+            .clone()
             .into_par_iter()
             .map(|i| {
                 let mut rng = Rng::from_stream(master_seed, i as u64);

@@ -4,6 +4,8 @@
 
 #[path = "../common/cli.rs"]
 mod common;
+#[path = "../common/shards.rs"]
+mod shards;
 
 use common::{assert_one_line_error, faint_quiet as faint, s, temp};
 use faint::host::calibrate::{self, noise};
@@ -51,6 +53,7 @@ fn false_alarm_rate(cal: &Calibration, input: &Path, runs: usize, l: usize) -> f
         seed: 99,
         reports: false,
         restart_every: Some(l),
+        runs: None,
     })
     .unwrap();
     let mut declared = vec![false; runs * l];
@@ -288,4 +291,28 @@ fn from_input_estimates_the_noise_under_a_target() {
         other => panic!("{other:?}"),
     }
     assert_eq!(c.runs, 100);
+}
+
+/// `faint calibrate` in three shards (noise runs 0..13, 13..26, 26..40 of a recording;
+/// then of a noise model estimated with `--from-input`), merged by `faint merge`, writes
+/// the unsharded run's calibration file byte for byte.
+#[test]
+fn three_shards_merge_into_the_unsharded_calibration() {
+    let dir = temp("calibrate", "shards");
+    let noise = dir.join("noise.npy");
+    doppler_noise(&noise, 40 * 8, 5);
+    for (i, source) in ["--input", "--from-input"].into_iter().enumerate() {
+        let root = dir.join(format!("run{i}"));
+        let mut args = vec!["calibrate", "crpf", source, s(&noise), "--pfa", "0.25"];
+        if source == "--input" {
+            args.extend(["--run-frames", "8"]);
+        } else {
+            args.extend(["--run-frames", "8", "--runs", "40"]);
+        }
+        let n = shards::assert_merged_equals_whole(&root, &args, 3, Some("cal.json"), |out| {
+            calibrate::shard_dir(out)
+        });
+        assert_eq!(n, 1);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -8,9 +8,12 @@ mod cli;
 #[path = "../common/cli.rs"]
 mod common;
 mod detectors;
+#[path = "../common/shards.rs"]
+mod merge;
 mod model;
 mod noise;
 mod reproduce;
+mod shards;
 mod sizes;
 mod statics;
 mod whiten;

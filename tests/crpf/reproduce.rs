@@ -29,6 +29,7 @@ fn quick_reproduction_writes_every_output() {
         echo_phase: Default::default(),
         birth_proposal: "exact".into(),
         quick: true,
+        shard: Default::default(),
     };
     run(&args).unwrap();
     let d = out.join("cgg_n100");

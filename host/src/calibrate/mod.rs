@@ -22,7 +22,12 @@ use anyhow::{bail, ensure, Context, Result};
 
 use crate::detect::calibration::{Calibration, FrameThreshold, Source, FORMAT};
 use crate::detect::{self, Request};
+use crate::shard::{self, Batch, Merged, Run, Shard};
 use crate::stats::detection::threshold_at_pfa;
+use serde::{Deserialize, Serialize};
+
+/// The command name in shard files.
+pub const COMMAND: &str = "calibrate";
 
 /// Expected noise exceedances per frame index a threshold needs: `runs * pfa >= 10`.
 pub const MIN_EXCEEDANCES: f64 = 10.0;
@@ -30,8 +35,8 @@ pub const MIN_EXCEEDANCES: f64 = 10.0;
 /// Default frames per run of a recording (`--input`), or its length if shorter.
 pub const DEFAULT_RUN_FRAMES: usize = 32;
 
-/// Command line of `faint calibrate`.
-#[derive(clap::Args, Debug, Clone)]
+/// Command line of `faint calibrate` (shard files keep it as JSON).
+#[derive(clap::Args, Debug, Clone, Serialize, Deserialize)]
 pub struct Args {
     /// Detector, as listed by `faint detect --list`.
     pub detector: String,
@@ -77,8 +82,60 @@ pub fn runs_needed(pfa: f64) -> usize {
     (MIN_EXCEEDANCES / pfa).ceil() as usize
 }
 
-/// Runs `faint calibrate` and returns what it wrote.
+/// What a calibration fixes before its runs; identical in every shard (a shard file's
+/// `meta`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Meta {
+    detector: String,
+    score: String,
+    runs: usize,
+    run_frames: usize,
+    source: Source,
+    config: serde_json::Value,
+}
+
+/// Runs `faint calibrate` (every run, whatever the environment) and returns what it
+/// wrote.
 pub fn run(a: &Args) -> Result<Calibration> {
+    let (meta, s) = scores(a, None)?;
+    let s = s.into_iter().next().map(|b| b.results).unwrap_or_default();
+    finish(a, meta, s)
+}
+
+/// `faint calibrate` with a shard (`--shard`, or a scheduler's array): runs only the
+/// shard's noise runs and writes their scores to `<out stem>.shards/` for `faint merge`;
+/// returns the shard file.
+pub fn run_shard(a: &Args, shard: Shard) -> Result<std::path::PathBuf> {
+    let t0 = std::time::Instant::now();
+    let (meta, batches) = scores(a, Some(shard))?;
+    let run = Run::new(COMMAND, a)?.with_meta(&meta)?;
+    let seconds = t0.elapsed().as_secs_f64();
+    shard::write(&shard_dir(&a.out), &run, shard, seconds, &batches)
+}
+
+/// The shard folder of a calibration written to `out`: `<out without .json>.shards`.
+pub fn shard_dir(out: &Path) -> std::path::PathBuf {
+    let stem = out.with_extension("");
+    let mut name = stem.as_os_str().to_os_string();
+    name.push(".shards");
+    std::path::PathBuf::from(name)
+}
+
+/// `faint merge` of `calibrate` shards: the calibration of the whole run, written to
+/// `out` if given, else to the run's `--out`.
+pub fn merge(m: &Merged, out: Option<&Path>) -> Result<Calibration> {
+    let mut a: Args = m.run.args()?;
+    if let Some(o) = out {
+        a.out = o.to_path_buf();
+    }
+    let meta: Meta = m.run.meta()?;
+    let s = m.results::<Vec<f64>>(&["runs".to_string()])?;
+    finish(&a, meta, s.into_iter().next().unwrap_or_default())
+}
+
+/// The per-frame largest scores `s[r][k]` of the noise runs `shard` holds (every run for
+/// `None`), as one batch `runs`, with what the calibration fixed before them.
+fn scores(a: &Args, shard: Option<Shard>) -> Result<(Meta, Vec<Batch<Vec<f64>>>)> {
     let entry = detect::find(&a.detector)?;
     crate::cli::probability("--pfa", a.pfa)?;
     if let Some(l) = a.run_frames {
@@ -160,31 +217,51 @@ pub fn run(a: &Args) -> Result<Calibration> {
         "--burn-in {} must be below --run-frames {l}",
         a.burn_in
     );
-    let req = Request {
-        input: &input,
-        config: a.config.as_deref().zip(Some(text.as_str())),
-        seed: a.seed,
-        reports: false,
-        restart_every: Some(l),
-    };
-    let outcome = (entry.run)(&req);
-    let _ = std::fs::remove_dir_all(&scratch);
-    let outcome = outcome?;
-    // s[r][k]: the largest score of run r at frame k.
-    let mut s = vec![vec![f64::NEG_INFINITY; l]; runs];
-    for row in &outcome.rows {
-        let (r, k) = (row.frame / l, row.frame % l);
-        if r >= runs {
-            continue;
+    let mut score = String::new();
+    let batch = Batch::run("runs", runs, shard, |range| -> Result<Vec<Vec<f64>>> {
+        let req = Request {
+            input: &input,
+            config: a.config.as_deref().zip(Some(text.as_str())),
+            seed: a.seed,
+            reports: false,
+            restart_every: Some(l),
+            runs: shard.map(|_| range.clone()),
+        };
+        let outcome = (entry.run)(&req);
+        let _ = std::fs::remove_dir_all(&scratch);
+        let outcome = outcome?;
+        score = outcome.score.name().to_string();
+        // s[r - first][k]: the largest score of run r at frame k.
+        let mut s = vec![vec![f64::NEG_INFINITY; l]; range.len()];
+        for row in &outcome.rows {
+            let (r, k) = (row.frame / l, row.frame % l);
+            if !range.contains(&r) {
+                continue;
+            }
+            ensure!(
+                !row.score.is_nan(),
+                "{}: a NaN score at frame {} of the noise",
+                entry.name,
+                row.frame
+            );
+            s[r - range.start][k] = s[r - range.start][k].max(f64::from(row.score));
         }
-        ensure!(
-            !row.score.is_nan(),
-            "{}: a NaN score at frame {} of the noise",
-            entry.name,
-            row.frame
-        );
-        s[r][k] = s[r][k].max(f64::from(row.score));
-    }
+        Ok(s)
+    })?;
+    let meta = Meta {
+        detector: entry.name.to_string(),
+        score,
+        runs,
+        run_frames: l,
+        source,
+        config,
+    };
+    Ok((meta, vec![batch]))
+}
+
+/// The thresholds from the scores `s[r][k]` of every noise run, written to `a.out`.
+fn finish(a: &Args, meta: Meta, s: Vec<Vec<f64>>) -> Result<Calibration> {
+    let l = meta.run_frames;
     // The statistics are f32 scores widened to f64: the cast back is exact.
     let finite = |x: f64| x.is_finite().then_some(x as f32);
     let mut thresholds = Vec::with_capacity(l - a.burn_in);
@@ -203,15 +280,15 @@ pub fn run(a: &Args) -> Result<Calibration> {
     let cal = Calibration {
         format: FORMAT,
         faint_version: env!("CARGO_PKG_VERSION").to_string(),
-        detector: entry.name.to_string(),
-        score: outcome.score.name().to_string(),
+        detector: meta.detector,
+        score: meta.score,
         pfa: a.pfa,
         burn_in: a.burn_in,
         run_frames: l,
-        runs,
-        source,
+        runs: meta.runs,
+        source: meta.source,
         seed: a.seed,
-        config,
+        config: meta.config,
         thresholds,
     };
     if let Some(parent) = a.out.parent().filter(|p| !p.as_os_str().is_empty()) {

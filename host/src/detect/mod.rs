@@ -126,6 +126,10 @@ pub struct Request<'a> {
     /// frame `r L` it is reset with the stream `derive_seed(seed, r)`. Frame indices in
     /// the outcome stay those of the input.
     pub restart_every: Option<usize>,
+    /// Only these runs of [`restart_every`](Self::restart_every) frames (one shard of
+    /// `faint calibrate`): run `r` still starts from the stream `derive_seed(seed, r)`
+    /// (run 0 from `seed`), so its scores are those of the whole input's run `r`.
+    pub runs: Option<std::ops::Range<usize>>,
 }
 
 /// One detection of one frame.
@@ -394,6 +398,9 @@ where
     let frames: Vec<&D::Frame> = frames.collect();
     let mut res = Ok(0);
     for (r, chunk) in frames.chunks(every).enumerate() {
+        if req.runs.as_ref().is_some_and(|runs| !runs.contains(&r)) {
+            continue;
+        }
         if r > 0 {
             det.reset(faint_core::rng::derive_seed(req.seed, r as u64));
         }

@@ -551,6 +551,7 @@ fn measure(
             seed: derive_seed(det_seed, g as u64),
             reports: false,
             restart_every: Some(l),
+            runs: None,
         };
         let outcome = (entry.run)(&req);
         let _ = std::fs::remove_file(&path);

@@ -30,10 +30,10 @@
 use faint_core::model::doppler::{ModelConfig, Window};
 use faint_core::rng::Rng;
 use faint_core::Complex32;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Background noise model.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Noise {
     /// Complex white Gaussian ("known statistics").

@@ -8,11 +8,14 @@ use anyhow::{ensure, Result};
 use super::evaluation::{ComparatorModel, Likelihood, VarSource};
 use crate::cli;
 use crate::scenario::crpf::{Noise, Othr};
+use crate::shard::ShardArg;
 use faint_core::detect::pf_tbd::BirthProposal;
 use faint_core::model::doppler::{Phase, Window};
+use serde::{Deserialize, Serialize};
 
 /// Analysis window of the scene and every detector's model (`--window`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
 pub enum SceneWindow {
     /// Symmetric Hamming (the preset; neighbouring bins correlated).
     #[default]
@@ -31,8 +34,9 @@ impl From<SceneWindow> for Window {
 }
 
 /// Command-line arguments of `faint reproduce crpf`. `--quick` changes the defaults of
-/// the arguments not given, never a given value.
-#[derive(clap::Args, Debug, Clone)]
+/// the arguments not given, never a given value. Shard files keep them as JSON
+/// (without `--shard`).
+#[derive(clap::Args, Debug, Clone, Serialize, Deserialize)]
 pub struct Args {
     /// Particles per detector: 100, 250, 500, 1000, 2000, 4000 or 6000 [default: 1000;
     /// --quick: 100].
@@ -102,10 +106,15 @@ pub struct Args {
     /// SNR 0:16:4, sweeps with 200 + 40 runs; never overrides a value given.
     #[arg(long)]
     pub quick: bool,
+    /// One shard of the runs (`--shard I/N`, see `faint merge`).
+    #[command(flatten)]
+    #[serde(skip)]
+    pub shard: ShardArg,
 }
 
 /// The detectors' phase model (`--phase`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
 pub enum PhaseModel {
     /// Zero at each frame's start (eq. 17; the presets).
     #[default]
@@ -124,7 +133,8 @@ impl From<PhaseModel> for Phase {
 }
 
 /// The simulated echo's phase (`--echo-phase`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
 pub enum EchoPhase {
     /// Zero at each frame's start (eq. 17; the paper's scene).
     #[default]

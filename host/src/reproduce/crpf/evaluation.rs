@@ -15,10 +15,10 @@ use faint_core::model::doppler::{
 use faint_core::rng::{derive_seed, Rng};
 use faint_core::statistic::{d_k, zeta_k};
 use faint_core::Complex32;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::args::Settings;
-use crate::montecarlo::run_trials;
+use crate::montecarlo::run_trial_range;
 use crate::scenario::crpf::{Noise, Othr, Run};
 use crate::stats::detection::{detection_rate, snr_at_pd, threshold_at_pfa, PdPoint};
 
@@ -26,7 +26,7 @@ use crate::stats::detection::{detection_rate, snr_at_pd, threshold_at_pfa, PdPoi
 pub const METHODS: [&str; 5] = ["CRPF-max", "CRPF-mean", "PF-mean", "JOTT-mean", "PF-LRT"];
 
 /// Test statistics of one run.
-#[derive(Debug, Clone, Copy, Serialize, Default)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, Default)]
 pub struct Stats {
     /// `zeta_K` of CRPF-TBD.
     pub crpf_max: f64,
@@ -61,7 +61,7 @@ impl Stats {
 }
 
 /// Where the Gaussian comparators' per-bin noise variance comes from (`--comparator-var`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum VarSource {
     /// Estimated from the run's K frames, `sum_k ||z_k||^2 / (K m)` (includes the target).
@@ -72,7 +72,7 @@ pub enum VarSource {
 }
 
 /// The Gaussian comparators' likelihood (`--comparator-likelihood`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Likelihood {
     /// Independent bins of the windowed frame (the preset).
@@ -282,8 +282,35 @@ pub fn batch(
     comparators: impl Into<Comparators>,
     label: &str,
 ) -> Result<Vec<Stats>> {
+    batch_range(
+        scenario,
+        noise,
+        snr_db,
+        particles,
+        crpf_cfg,
+        0..trials,
+        master,
+        comparators,
+        label,
+    )
+}
+
+/// [`batch`] for the runs `range` only (one shard): run `i` is the run `i` of the whole
+/// batch.
+#[allow(clippy::too_many_arguments)]
+pub fn batch_range(
+    scenario: &Othr,
+    noise: Noise,
+    snr_db: Option<f64>,
+    particles: usize,
+    crpf_cfg: &CrpfConfig,
+    range: std::ops::Range<usize>,
+    master: u64,
+    comparators: impl Into<Comparators>,
+    label: &str,
+) -> Result<Vec<Stats>> {
     let comparators = comparators.into();
-    run_trials(master, trials, label, |i, rng: &mut Rng| {
+    run_trial_range(master, range, label, |i, rng: &mut Rng| {
         let run = scenario.simulate(snr_db, noise, rng);
         run_stats(
             particles,
@@ -350,29 +377,18 @@ pub(super) struct PdCurves {
     pub(super) fd_err: Vec<(f64, f64, usize)>,
 }
 
-/// H1 runs at every SNR of `grid`, each statistic against its threshold in `thresholds`.
+/// Pd at every SNR of `grid` from its H1 runs (`h1[j]` at `grid[j]`), each statistic
+/// against its threshold in `thresholds`.
 pub(super) fn pd_vs_snr(
     a: &Settings,
-    sc: &Othr,
-    cfg: &CrpfConfig,
     grid: &[f64],
+    h1_runs: &[Vec<Stats>],
     thresholds: &[f64; 5],
 ) -> Result<PdCurves> {
     let mut rows = Vec::new();
     let mut curves: Vec<Vec<PdPoint>> = vec![Vec::new(); 5];
     let mut fd_err = Vec::new();
-    for (j, &snr) in grid.iter().enumerate() {
-        let h1 = batch(
-            sc,
-            a.noise,
-            Some(snr),
-            a.particles,
-            cfg,
-            a.trials,
-            derive_seed(a.seed, 100 + j as u64),
-            a.comparator_model(sc),
-            &format!("crpf {snr} dB"),
-        )?;
+    for (&snr, h1) in grid.iter().zip(h1_runs) {
         for (m, name) in METHODS.iter().enumerate() {
             let v: Vec<f64> = h1.iter().map(|s| s.values()[m]).collect();
             let p = detection_rate(&v, thresholds[m]);
@@ -446,12 +462,9 @@ pub(super) struct Sweeps {
     pub(super) series: Vec<Vec<(f64, f64)>>,
 }
 
-/// Fig. 5: Pd of CRPF-max and CRPF-mean at 5 dB (Gaussian) over `r_th` and `lambda`.
-pub(super) fn sweeps(a: &Settings, sc: &Othr, base: &CrpfConfig) -> Result<Sweeps> {
-    let pfa = a.pfa.max(10.0 / a.sweep_h0_trials as f64);
-    let mut rows = Vec::new();
-    let mut series = vec![Vec::new(); 4];
-    let configs: Vec<(&'static str, f64, CrpfConfig)> = (0..=8)
+/// The Fig. 5 sweep configurations: `(parameter, value, config)`, `r_th` then `lambda`.
+pub(super) fn sweep_configs(base: &CrpfConfig) -> Vec<(&'static str, f64, CrpfConfig)> {
+    (0..=8)
         .map(|i| {
             let r = 0.05 * i as f64;
             (
@@ -474,31 +487,21 @@ pub(super) fn sweeps(a: &Settings, sc: &Othr, base: &CrpfConfig) -> Result<Sweep
                 },
             )
         }))
-        .collect();
-    for (ci, (param, value, cfg)) in configs.iter().enumerate() {
-        let seed = derive_seed(a.seed, 1000 + ci as u64);
-        let h0 = batch(
-            sc,
-            Noise::Gaussian,
-            None,
-            a.particles,
-            cfg,
-            a.sweep_h0_trials,
-            seed,
-            false,
-            &format!("sweep {param}={value:.2} H0"),
-        )?;
-        let h1 = batch(
-            sc,
-            Noise::Gaussian,
-            Some(5.0),
-            a.particles,
-            cfg,
-            a.sweep_trials,
-            derive_seed(seed, 1),
-            false,
-            &format!("sweep {param}={value:.2} H1"),
-        )?;
+        .collect()
+}
+
+/// Fig. 5: Pd of CRPF-max and CRPF-mean at 5 dB (Gaussian) over `r_th` and `lambda`,
+/// from the H0 and H1 runs `runs[ci]` of each configuration of [`sweep_configs`].
+pub(super) fn sweeps(
+    a: &Settings,
+    base: &CrpfConfig,
+    runs: &[(Vec<Stats>, Vec<Stats>)],
+) -> Result<Sweeps> {
+    let pfa = a.pfa.max(10.0 / a.sweep_h0_trials as f64);
+    let mut rows = Vec::new();
+    let mut series = vec![Vec::new(); 4];
+    let configs = sweep_configs(base);
+    for ((param, value, _), (h0, h1)) in configs.iter().zip(runs) {
         for (mi, (method, f)) in [
             ("CRPF-max", (|s: &Stats| s.crpf_max) as fn(&Stats) -> f64),
             ("CRPF-mean", |s: &Stats| s.crpf_mean),
