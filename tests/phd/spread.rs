@@ -52,6 +52,7 @@ fn final_frame(phys: &Physics, cfg: &Value, runs: &[SimRun], tag: &str) -> Vec<(
         seed: 5,
         reports: false,
         restart_every: Some(FRAMES),
+        runs: None,
     })
     .unwrap();
     let mut res = vec![(false, 0usize); runs.len()];

@@ -201,7 +201,10 @@ pub struct PointSpread {
     /// `0..=8`, at most [`MAX_COVERED_CELLS`] cells in all). A configuration file may
     /// give one number for all three axes (the form written before the axes were
     /// separate).
-    #[cfg_attr(feature = "serde", serde(deserialize_with = "half_width_serde::deserialize"))]
+    #[cfg_attr(
+        feature = "serde",
+        serde(deserialize_with = "half_width_serde::deserialize")
+    )]
     pub half_width: [usize; 3],
 }
 
