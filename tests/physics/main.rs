@@ -25,6 +25,7 @@ fn args(detector: &str, pfa: f64, runs: usize, frames: usize, snr: &str) -> Args
         out: None,
         phase: PhaseArg::Random,
         swerling: 0,
+        rotor_blades: 0,
     }
 }
 
