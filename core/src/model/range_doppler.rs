@@ -172,9 +172,11 @@ impl RdSpread {
         smear: f32,
     ) -> Option<Self> {
         g.validate().ok()?;
-        if !(range_resolution.is_finite() && range_resolution > 0.0)
-            || !(smear.is_finite() && smear >= 0.0)
-        {
+        let ok = range_resolution.is_finite()
+            && range_resolution > 0.0
+            && smear.is_finite()
+            && smear >= 0.0;
+        if !ok {
             return None;
         }
         let n = g.n_velocity;
