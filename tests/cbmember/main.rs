@@ -7,3 +7,4 @@ mod cli;
 #[path = "../common/cli.rs"]
 mod common;
 mod filter;
+mod physical;

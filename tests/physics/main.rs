@@ -26,6 +26,7 @@ fn args(detector: &str, pfa: f64, runs: usize, frames: usize, snr: &str) -> Args
         phase: PhaseArg::Random,
         swerling: 0,
         cube_spread: "sinc".into(),
+        rotor_blades: 0,
     }
 }
 

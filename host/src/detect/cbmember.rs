@@ -6,11 +6,18 @@
 //! `config.gain` makes `rho` the linear peak SNR (eq. 19) at the map's centre range, and
 //! births draw `rho = 10^(U[lo, hi] / 10)` from `snr_db.birth`; `"noise": "as-is"` takes
 //! the map and `config` in absolute units (the preset).
+//!
+//! `"spread"` sets the measurement model's spread `config.spread`: `{"geometry": {...}}`
+//! (the default file) derives it from the map's geometry, the slow-time window, the
+//! range resolution and the blades' velocity sweep within a CPI
+//! ([`RdSpread::from_geometry`]); `"config"` (also when the key is absent) takes
+//! `config.spread` as written (the paper's fixed `zeta_r = 3` m, `zeta_v = 5` m/s).
 
 use anyhow::{anyhow, bail, ensure, Result};
 use faint_core::detect::cbmember::{gain_for_snr, BirthPlacement, CbmemberConfig};
 use faint_core::detect::{Detector, Validate};
-use faint_core::model::range_doppler::PointModel;
+use faint_core::model::doppler::Window;
+use faint_core::model::range_doppler::{PointModel, RdSpread};
 use serde::{Deserialize, Serialize};
 
 use super::phd::normalise;
@@ -27,6 +34,58 @@ pub struct CbmemberSnr {
     pub birth: [f32; 2],
 }
 
+/// How the spread of the measurement model is set.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum SpreadFrom {
+    /// `config.spread` as written.
+    #[default]
+    Config,
+    /// From the map's geometry ([`RdSpread::from_geometry`]).
+    Geometry(GeometrySpread),
+}
+
+/// What [`RdSpread::from_geometry`] needs beyond `config.geometry`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GeometrySpread {
+    /// Window across the pulses of the slow-time DFT.
+    pub window: Window,
+    /// Range resolution of the compressed pulse (m).
+    pub range_resolution_m: f32,
+    /// Velocity a blade sweeps within a CPI (m/s; 0 for the body alone), uniform.
+    pub blade_sweep_m_per_s: f32,
+}
+
+impl GeometrySpread {
+    /// The spread for `c`'s geometry.
+    pub fn spread(&self, c: &CbmemberConfig) -> Result<RdSpread> {
+        RdSpread::from_geometry(
+            &c.geometry,
+            self.window,
+            self.range_resolution_m,
+            self.blade_sweep_m_per_s,
+        )
+        .ok_or_else(|| {
+            anyhow!(
+                "spread.geometry: range_resolution_m must be finite and > 0 and \
+                 blade_sweep_m_per_s finite and >= 0 (got {} and {})",
+                self.range_resolution_m,
+                self.blade_sweep_m_per_s
+            )
+        })
+    }
+}
+
+/// The blade sweep of the rotor-UAV preset's rotor within one CPI, as an rms over the
+/// blade phase: `V omega CPI / sqrt(2)` with `V = 10` m/s, `omega = 0.06 pi` rad/s and
+/// `CPI = lambda / (2 velocity_bin)` (`lambda = 0.03` m, 0.192 s on the default map):
+/// 0.256 m/s.
+pub fn rotor_uav_blade_sweep(c: &CbmemberConfig) -> f32 {
+    let cpi = 0.03 / (2.0 * f64::from(c.geometry.velocity_bin));
+    (10.0 * 0.06 * std::f64::consts::PI * cpi / std::f64::consts::SQRT_2) as f32
+}
+
 /// `faint detect`'s configuration file for CBMeMBer.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -37,6 +96,9 @@ pub struct CbmemberFile {
     /// SNR values (required with `"estimate"`, refused with `"as-is"`).
     #[serde(default)]
     pub snr_db: Option<CbmemberSnr>,
+    /// How `config.spread` is set (absent: `"config"`).
+    #[serde(default)]
+    pub spread: SpreadFrom,
     /// The core configuration.
     pub config: CbmemberConfig,
 }
@@ -91,6 +153,16 @@ impl CbmemberFile {
                 }
             }
         }
+        if let SpreadFrom::Geometry(gs) = self.spread {
+            let want = gs.spread(&c)?;
+            ensure!(
+                c.spread == want,
+                "config.spread is set by \"spread\": {{\"geometry\": ..}} (zeta_r {}, zeta_v {} \
+                 for this geometry); write those values, or use \"spread\": \"config\"",
+                want.zeta_r,
+                want.zeta_v
+            );
+        }
         c.validate().map_err(|e| anyhow!("{e}"))?;
         Ok(c)
     }
@@ -111,11 +183,32 @@ pub fn default_cbmember_file(model: PointModel) -> CbmemberFile {
     c.birth.range[1] = c.spread.zeta_r / 2.0;
     // rho is the linear SNR: a random walk of 5 % of a 0 dB target per frame.
     c.process.rho = 0.05;
+    let gs = GeometrySpread {
+        window: Window::Hamming,
+        range_resolution_m: c.geometry.range_bin,
+        blade_sweep_m_per_s: match model {
+            PointModel::Joint => rotor_uav_blade_sweep(&c),
+            PointModel::DopplerOnly => 0.0,
+        },
+    };
+    apply_geometry_spread(&mut c, &gs);
     CbmemberFile {
         noise: NoiseLevel::Estimate,
         snr_db: Some(s),
+        spread: SpreadFrom::Geometry(gs),
         config: c,
     }
+}
+
+/// Sets `c.spread` from `gs` and the values tied to the spread: the birth range std
+/// (`zeta_r / 2`) and the likelihood (the exact form: a block of 16 velocity bins would
+/// be wider than the spread).
+fn apply_geometry_spread(c: &mut CbmemberConfig, gs: &GeometrySpread) {
+    if let Ok(s) = gs.spread(c) {
+        c.spread = s;
+    }
+    c.birth.range[1] = c.spread.zeta_r / 2.0;
+    c.likelihood = faint_core::detect::cbmember::Likelihood::Exact;
 }
 
 pub(super) fn default_cbmember(model: PointModel) -> String {

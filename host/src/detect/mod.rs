@@ -39,7 +39,10 @@ mod output;
 mod phd;
 mod plots;
 
-pub use cbmember::{default_cbmember_file, CbmemberFile, CbmemberSnr};
+pub use cbmember::{
+    default_cbmember_file, rotor_uav_blade_sweep, CbmemberFile, CbmemberSnr, GeometrySpread,
+    SpreadFrom,
+};
 pub use doppler::{bin_variance, DopplerFile, GaussFile, PARTICLES};
 pub use dp::{robust_noise, DpFile, DpNoise, DpSettings};
 pub use output::{check_input, read_truth, write, write_plots, Selection, Written};

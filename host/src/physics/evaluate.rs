@@ -138,6 +138,10 @@ pub struct Args {
     /// these standard deviations in cells (range, Doppler, azimuth). Power cubes only.
     #[arg(long, default_value = "sinc")]
     pub cube_spread: String,
+    /// Power maps: rotor blades on the target (eq. 11 of the rotor-UAV paper, 2023; blade
+    /// velocity 10 m/s, rotor rate 0.06 pi rad/s, wavelength 0.03 m), 0 for a point target.
+    #[arg(long, default_value_t = 0)]
+    pub rotor_blades: u32,
 }
 
 /// `--phase`.
@@ -313,7 +317,12 @@ pub fn run(a: &Args) -> Result<Evaluation> {
             p.swerling = swerling;
             p.response = super::cubes::Response::parse(&a.cube_spread)?;
         }
-        Physics::Maps(p) => p.swerling = swerling,
+        Physics::Maps(p) => {
+            p.swerling = swerling;
+            if a.rotor_blades > 0 {
+                p.rotor = Some(super::maps::Rotor::rotor_uav(a.rotor_blades));
+            }
+        }
         Physics::Plots(_) => {}
     }
     ensure!(
@@ -323,6 +332,12 @@ pub fn run(a: &Args) -> Result<Evaluation> {
         entry.name,
         entry.input
     );
+    ensure!(
+        a.rotor_blades == 0 || matches!(phys, Physics::Maps(_)),
+        "--rotor-blades {}: only for power-map detectors (cbmember, cbmember-doppler)",
+        a.rotor_blades
+    );
+    phys.validate()?;
     let l = match (a.frames, &phys) {
         (Some(l), _) => l,
         (None, Physics::Doppler(_)) => 20,
@@ -445,6 +460,9 @@ pub fn run(a: &Args) -> Result<Evaluation> {
     }
     if a.burn_in > 0 {
         user_set.push_str(&format!(", --burn-in {}", a.burn_in));
+    }
+    if a.rotor_blades > 0 {
+        user_set.push_str(&format!(", --rotor-blades {}", a.rotor_blades));
     }
     let ev = Evaluation {
         detector: entry.name.to_string(),

@@ -1,7 +1,8 @@
 //! Range x velocity power maps from the physics: a point target's echo over `Nv` pulses
 //! of slow time per range cell, windowed and transformed across the pulses, in complex
-//! white Gaussian noise. No rotor: the target is a point scatterer (no blade
-//! micro-Doppler), so the map holds the body line only.
+//! white Gaussian noise. Optionally ([`Rotor`]) the target also carries `B` rotor blade
+//! tips (eq. 11 of the rotor-UAV paper, below); without it the map holds the body line
+//! only.
 //!
 //! Map `(Nr, Nv)` per frame, row-major (range rows, velocity columns); pixel `(i, j)`
 //! centred at `r_i = range_start + (i + 0.5) range_bin`,
@@ -26,6 +27,14 @@
 //! `w_in` complex white Gaussian with `E|w|^2 = sigma^2`, independent over range cells
 //! and pulses; `phi_k` uniform in `[0, 2 pi)`, independent per frame; range migration
 //! within a frame's pulses is neglected.
+//!
+//! **Rotor** (eq. 10-11): blade `b = 0..B-1`, a point of amplitude `a_k` (that of the
+//! body) at radius `R = V / omega` turning at `omega`, adds
+//! `a_k exp(j (phi - 2 pi v n / Va - 4 pi R cos(omega t_n + theta_0 + 2 pi b / B) / lambda))`,
+//! `t_n = k dt + n lambda / (2 Va)` (pulse interval `Tr = lambda / (2 Va)`), its
+//! instantaneous velocity `v - V sin(omega t + theta_b)` (eq. 13's sign); `theta_0`
+//! uniform per run. Within a CPI of `Nv Tr` s a blade's velocity sweeps up to
+//! `V omega Nv Tr` m/s, so its peak is wider than the body's.
 //!
 //! SNR = the peak-pixel power over the noise power per pixel for a target at a pixel
 //! centre, the peak SNR of eq. 19 of the rotor-UAV paper (Journal of Radars, 2023):
@@ -73,6 +82,34 @@ pub struct MapPhysics {
     pub velocity_range: (f64, f64),
     /// Amplitude fluctuation.
     pub swerling: Swerling,
+    /// Rotor blades on the target (`None`: a point target).
+    pub rotor: Option<Rotor>,
+}
+
+/// Rotor blade tips of eq. 11 (rotor-UAV paper, 2023).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rotor {
+    /// Blade count `B`.
+    pub blades: u32,
+    /// Maximum blade velocity `V = omega R` (m/s).
+    pub blade_speed: f64,
+    /// Rotor rate `omega` (rad/s).
+    pub omega: f64,
+    /// Wavelength `lambda` (m).
+    pub wavelength: f64,
+}
+
+impl Rotor {
+    /// The rotor-UAV preset's rotor: `B = 2`, `V = 10` m/s, `omega = 0.06 pi` rad/s,
+    /// `lambda = 0.03` m.
+    pub fn rotor_uav(blades: u32) -> Self {
+        Self {
+            blades,
+            blade_speed: 10.0,
+            omega: 0.06 * std::f64::consts::PI,
+            wavelength: 0.03,
+        }
+    }
 }
 
 /// One simulated target's state at a frame.
@@ -99,6 +136,7 @@ impl MapPhysics {
             noise_power: 1.0,
             velocity_range: (velocity.start, velocity.end()),
             swerling: Swerling::Zero,
+            rotor: None,
         }
     }
 
@@ -135,6 +173,23 @@ impl MapPhysics {
             "noise power {}: must be finite and >= 0",
             self.noise_power
         );
+        if let Some(r) = self.rotor {
+            ensure!(
+                (1..=8).contains(&r.blades),
+                "rotor: {} blades, must be in 1..=8",
+                r.blades
+            );
+            for (n, v) in [
+                ("blade speed", r.blade_speed),
+                ("rotor rate", r.omega),
+                ("wavelength", r.wavelength),
+            ] {
+                ensure!(
+                    v.is_finite() && v > 0.0,
+                    "rotor {n} {v}: must be finite and > 0"
+                );
+            }
+        }
         ensure!(
             self.velocity_range.0.is_finite()
                 && self.velocity_range.1.is_finite()
@@ -203,6 +258,10 @@ impl MapPhysics {
         rng: &mut Rng,
     ) -> (Vec<f32>, Vec<MapTruth>) {
         let path = amplitude.map(|a| (a, self.draw_path(frames, rng)));
+        let theta0 = match (path, self.rotor) {
+            (Some(_), Some(_)) => 2.0 * std::f64::consts::PI * f64::from(rng.uniform()),
+            _ => 0.0,
+        };
         let mut out = Vec::with_capacity(frames * self.pixels());
         let mut truth = Vec::new();
         let kernel = self.kernel();
@@ -218,7 +277,8 @@ impl MapPhysics {
                 });
                 (ak, r, v)
             });
-            self.push_frame(echo, &kernel, fft.as_ref(), rng, &mut out);
+            let t0 = k as f64 * self.dt;
+            self.push_frame(echo, (t0, theta0), &kernel, fft.as_ref(), rng, &mut out);
         }
         (out, truth)
     }
@@ -231,6 +291,7 @@ impl MapPhysics {
         let fft = FftPlanner::<f64>::new().plan_fft_inverse(self.velocity.n);
         self.push_frame(
             Some((ak, r, v)),
+            (0.0, 0.0),
             &self.kernel(),
             fft.as_ref(),
             rng,
@@ -252,10 +313,12 @@ impl MapPhysics {
             .collect()
     }
 
-    /// Appends one map: noise, plus the echo `(a_k, r, v)` with a fresh random phase.
+    /// Appends one map: noise, plus the echo `(a_k, r, v)` with a fresh random phase (and
+    /// its rotor's blades at time `t0` of the frame's first pulse, rotor phase `theta0`).
     fn push_frame(
         &self,
         echo: Option<(f64, f64, f64)>,
+        (t0, theta0): (f64, f64),
         kernel: &[Complex64],
         fft: &dyn rustfft::Fft<f64>,
         rng: &mut Rng,
@@ -273,7 +336,19 @@ impl MapPhysics {
             let tone: Vec<Complex64> = (0..m)
                 .map(|n| {
                     let cycles = (v * n as f64 / self.ambiguity()).rem_euclid(1.0);
-                    Complex64::from_polar(ak, phi - two_pi * cycles)
+                    let mut t = Complex64::from_polar(ak, phi - two_pi * cycles);
+                    if let Some(rot) = self.rotor {
+                        let tr = rot.wavelength / (2.0 * self.ambiguity());
+                        let radius = rot.blade_speed / rot.omega;
+                        let tn = t0 + n as f64 * tr;
+                        for b in 0..rot.blades {
+                            let tb = theta0 + two_pi * f64::from(b) / f64::from(rot.blades);
+                            let c = 2.0 * radius * (rot.omega * tn + tb).cos() / rot.wavelength;
+                            let ph = phi - two_pi * (cycles + c.rem_euclid(1.0));
+                            t += Complex64::from_polar(ak, ph);
+                        }
+                    }
+                    t
                 })
                 .collect();
             (u, c, tone)

@@ -126,11 +126,12 @@ pub enum BirthPlacement {
     /// `r ~ N(range)`, `v ~ N(velocity)` (Table 2, the paper).
     #[default]
     Prior,
-    /// From the previous frame: `r ~ N(r_peak, range[1]^2)` around the peak of the range
-    /// profile (row sums of the map summed over `+-zeta_r`, rows within `KAPPA zeta_r` of
-    /// a reported component skipped), `v ~ U` over the whole velocity axis (the body's
-    /// Doppler is not taken from the map: a blade can outshine it). Prior before the
-    /// first frame.
+    /// From the previous frame: `v ~ U` over the whole velocity axis (the body's Doppler
+    /// is not taken from the map: a blade can outshine it) and
+    /// `r ~ N(r_peak + v eps, range[1]^2)`, `r_peak` the peak of the previous frame's
+    /// range profile (row sums of the map summed over `+-zeta_r`, rows within
+    /// `KAPPA zeta_r` of a reported component skipped) moved on by one frame. Prior
+    /// before the first frame.
     RangePeak,
 }
 
@@ -643,10 +644,9 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
                 let g = &cfg.geometry;
                 let r = rng.gaussian(p, b.range[1]);
                 let v0 = g.velocity_start;
-                (
-                    r,
-                    rng.uniform_range(v0, v0 + g.n_velocity as f32 * g.velocity_bin),
-                )
+                let v = rng.uniform_range(v0, v0 + g.n_velocity as f32 * g.velocity_bin);
+                // The peak is the previous frame's: move it on by the particle's velocity.
+                (r + v * cfg.dt, v)
             }
             None => (
                 rng.gaussian(b.range[0], b.range[1]),
