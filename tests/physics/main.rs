@@ -5,6 +5,7 @@
 #[path = "../common/cli.rs"]
 mod common;
 
+use faint::host::detect::{CbmemberFile, SpreadFrom};
 use std::path::{Path, PathBuf};
 
 use common::{assert_one_line_error, faint_quiet as faint, s, temp};
@@ -153,6 +154,14 @@ fn reduced(detector: &str, dir: &Path, edit: impl Fn(&mut Value)) -> PathBuf {
     let e = faint::host::detect::find(detector).unwrap();
     let mut v: Value = serde_json::from_str(&(e.default_config)()).unwrap();
     edit(&mut v["config"]);
+    // A map file whose spread follows its geometry gets the spread of the new geometry
+    // (the user path refuses a stale one, as it would a user's edited geometry).
+    if let Ok(file) = serde_json::from_value::<CbmemberFile>(v.clone()) {
+        if let SpreadFrom::Geometry(gs) = file.spread {
+            let spread = gs.spread(&file.config).unwrap();
+            v["config"]["spread"] = serde_json::to_value(spread).unwrap();
+        }
+    }
     let p = dir.join(format!("{detector}.json"));
     std::fs::write(&p, serde_json::to_string_pretty(&v).unwrap()).unwrap();
     p
