@@ -147,13 +147,7 @@ impl GaussConfig {
             return Ok(inv);
         }
         let m = self.model.bins.max(1);
-        let e: f64 = (0..m)
-            .map(|n| {
-                let w = self.model.window.coefficient(n, m);
-                w * w
-            })
-            .sum();
-        let r = (f64::from(inv) * e / m as f64) as f32;
+        let r = (f64::from(inv) * self.model.window.energy(m) / m as f64) as f32;
         if r.is_finite() && r > 0.0 {
             Ok(r)
         } else {
@@ -195,7 +189,7 @@ impl Validate for GaussConfig {
     fn validate(&self) -> Result<()> {
         self.build()?;
         self.weighing_inv_var(self.noise_var)?;
-        Whitener::inactive().configure(self.likelihood, self.model.window, self.model.bins)
+        Whitener::check(self.likelihood, self.model.window, self.model.bins)
     }
 }
 

@@ -72,11 +72,6 @@ fn window_gain_db(window: Window, m: usize) -> f64 {
     10.0 * (s * s / s2).log10()
 }
 
-/// `sum_n w_n^2`: the bin variance of unit-variance white time-domain noise.
-fn window_energy(window: Window, m: usize) -> f64 {
-    (0..m).map(|n| window.coefficient(n, m).powi(2)).sum()
-}
-
 /// CRPF-TBD's default configuration file: the OTHR preset, 1000 particles, an unknown
 /// phase per frame (recorded echoes; the preset's zero phase is the paper's model).
 pub(super) fn default_crpf() -> String {
@@ -118,7 +113,7 @@ fn normalise<C>(
     if file.noise == NoiseLevel::AsIs {
         return Ok(None);
     }
-    let energy = window_energy(model.window, model.bins);
+    let energy = model.window.energy(model.bins);
     let v = bin_variance(frames).ok_or_else(|| {
         anyhow!(
             "{}: the median bin power is 0 or not finite: no noise level to estimate \

@@ -56,6 +56,17 @@ impl Window {
             Window::Hann => 0.5 - 0.5 * c,
         }
     }
+
+    /// `sum_n w_n^2` of an `m`-point window, in `f64`: the bin variance of unit-variance
+    /// white time-domain noise.
+    pub fn energy(self, m: usize) -> f64 {
+        (0..m)
+            .map(|n| {
+                let w = self.coefficient(n, m);
+                w * w
+            })
+            .sum()
+    }
 }
 
 /// The target's carrier phase at the start of each frame, as the observation model

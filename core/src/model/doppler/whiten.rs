@@ -144,22 +144,13 @@ impl Whitener {
     /// ([`Error::InvalidConfig`]), before any change: `m` outside `1..=MAX_BINS`, a window
     /// coefficient below [`MIN_WINDOW_COEFFICIENT`].
     pub fn configure(&mut self, likelihood: Likelihood, window: Window, m: usize) -> Result<()> {
-        if !(1..=MAX_BINS).contains(&m) {
-            return Err(Error::InvalidConfig("bins per frame (1..=512)"));
-        }
-        if likelihood == Likelihood::Independent || window == Window::Rectangular {
+        if !Self::check_active(likelihood, window, m)? {
             self.m = 0;
             return Ok(());
         }
         let mut inv_w = [0.0f64; MAX_BINS];
         for (n, iw) in inv_w.iter_mut().enumerate().take(m) {
-            let w = window.coefficient(n, m);
-            if !(w.is_finite() && w >= MIN_WINDOW_COEFFICIENT) {
-                return Err(Error::InvalidConfig(
-                    "likelihood window: the window has a zero coefficient",
-                ));
-            }
-            *iw = 1.0 / w;
+            *iw = 1.0 / window.coefficient(n, m);
         }
         for (d, c) in self.kernel.iter_mut().enumerate().take(m) {
             let (mut re, mut im) = (0.0f64, 0.0f64);
@@ -173,6 +164,32 @@ impl Whitener {
         }
         self.m = m;
         Ok(())
+    }
+
+    /// The errors of [`configure`](Self::configure), without building the kernel (or
+    /// needing a whitener's 8 KiB).
+    pub fn check(likelihood: Likelihood, window: Window, m: usize) -> Result<()> {
+        Self::check_active(likelihood, window, m).map(|_| ())
+    }
+
+    /// Checks `m` and, when frames are whitened, every window coefficient; returns whether
+    /// they are.
+    fn check_active(likelihood: Likelihood, window: Window, m: usize) -> Result<bool> {
+        if !(1..=MAX_BINS).contains(&m) {
+            return Err(Error::InvalidConfig("bins per frame (1..=512)"));
+        }
+        if likelihood == Likelihood::Independent || window == Window::Rectangular {
+            return Ok(false);
+        }
+        for n in 0..m {
+            let w = window.coefficient(n, m);
+            if !(w.is_finite() && w >= MIN_WINDOW_COEFFICIENT) {
+                return Err(Error::InvalidConfig(
+                    "likelihood window: the window has a zero coefficient",
+                ));
+            }
+        }
+        Ok(true)
     }
 
     /// Whether frames are whitened.

@@ -142,10 +142,7 @@ fn comparator_config(
             }
             Likelihood::Window => whitened_run_variance(run, model.window, m)?,
         },
-        VarSource::True => {
-            let e: f64 = (0..m).map(|n| model.window.coefficient(n, m).powi(2)).sum();
-            (cm.time_var * e) as f32
-        }
+        VarSource::True => (cm.time_var * model.window.energy(m)) as f32,
     };
     Ok(GaussConfig {
         model,
@@ -172,8 +169,7 @@ fn whitened_run_variance(run: &Run, window: Window, m: usize) -> Result<f32> {
         white.push(wh.apply(f)?.to_vec());
     }
     let v = estimate_noise_variance(white.iter().map(|f| f.as_slice()), m)?;
-    let e: f64 = (0..m).map(|n| window.coefficient(n, m).powi(2)).sum();
-    Ok((f64::from(v) * e / m as f64) as f32)
+    Ok((f64::from(v) * window.energy(m) / m as f64) as f32)
 }
 
 /// Runs a detector over a run's frames; returns the per-frame reports.
