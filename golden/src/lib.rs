@@ -42,7 +42,7 @@ use faint_core::math;
 use faint_core::particles::{self, Scheme};
 use faint_core::rng::Rng;
 
-mod mht;
+pub mod mht;
 
 /// Master seed of every golden case.
 pub const SEED: u64 = 0x00FA_1A7F_601D_E115;

@@ -11,6 +11,47 @@ use faint_core::scene;
 
 type Det = MhtTbd<48, 10, 32, 30, 4>;
 
+/// Seed of the firmware's MHT-TBD cost scene ([`cost_scan`]).
+pub const COST_SEED: u64 = 0x0003_F4DA_C96F_92B1;
+
+/// Clutter plots per scan of [`cost_scan`]: the sea-clutter preset's densest clutter (a
+/// fixed count, the Poisson mean).
+pub const COST_CLUTTER: usize = 398;
+
+/// Target `i` (0..5) of [`cost_scan`] at scan `s`: fixed starts and velocities inside
+/// the 6 km x 6 km area.
+fn cost_target(i: usize, s: usize) -> (f32, f32) {
+    const T: [[f32; 4]; 5] = [
+        [1000.0, 1200.0, 12.0, 5.0],
+        [4800.0, 900.0, -6.0, 14.0],
+        [3000.0, 3000.0, 3.0, -3.0],
+        [1500.0, 5000.0, 15.0, -8.0],
+        [5200.0, 4200.0, -11.0, -10.0],
+    ];
+    let t = T[i % 5];
+    let dt = 5.0 * s as f32;
+    (t[0] + t[2] * dt, t[1] + t[3] * dt)
+}
+
+/// Scan `s` of the firmware's MHT-TBD cost scene (its instruction rows and the cycle
+/// image): [`COST_CLUTTER`] clutter plots uniform over 6 km x 6 km, then the 5 targets,
+/// each detected with probability 0.85 and 5 m noise. Writes `out[..n]`, returns `n`
+/// (`out` needs `COST_CLUTTER + 5` plots; a shorter one gets fewer).
+pub fn cost_scan(rng: &mut Rng, s: usize, out: &mut [Plot]) -> usize {
+    let k = COST_CLUTTER.min(out.len());
+    let mut n = scene::clutter_plots(rng, [0.0, 6000.0, 0.0, 6000.0], &mut out[..k], |_| 1.0);
+    for i in 0..5 {
+        let (x, y) = cost_target(i, s);
+        if let Some((x, y)) = scene::detection(rng, 0.85, x, y, 5.0) {
+            if let Some(o) = out.get_mut(n) {
+                *o = Plot::new(9.0, x, y);
+                n += 1;
+            }
+        }
+    }
+    n
+}
+
 fn scan(rng: &mut Rng, s: usize, out: &mut [Plot; 48]) -> usize {
     let n = scene::clutter_plots(rng, [0.0, 1500.0, 0.0, 1500.0], &mut out[..40], |_| 1.0);
     let t = s as f32;

@@ -49,7 +49,7 @@ use faint_core::model::doppler::{DopplerModel, DopplerReport, Window};
 use faint_core::model::plot::Plot;
 use faint_core::model::range_doppler::PointModel;
 use faint_core::rng::Rng;
-use faint_core::{scene, Complex32};
+use faint_core::Complex32;
 
 use harness::{check, measure, Static, Text};
 
@@ -405,38 +405,14 @@ static SCAN: Static<[Plot; 512]> = Static::new([Plot::new(0.0, 0.0, 0.0); 512]);
 
 /// `src/mht.rs`: 29 censoring scans (scan 2 traced), then the period end (traced).
 fn mht() {
-    const SEED: u64 = 0x0003_F4DA_C96F_92B1;
-    fn target(i: usize, s: usize) -> (f32, f32) {
-        const T: [[f32; 4]; 5] = [
-            [1000.0, 1200.0, 12.0, 5.0],
-            [4800.0, 900.0, -6.0, 14.0],
-            [3000.0, 3000.0, 3.0, -3.0],
-            [1500.0, 5000.0, 15.0, -8.0],
-            [5200.0, 4200.0, -11.0, -10.0],
-        ];
-        let t = T[i];
-        let dt = 5.0 * s as f32;
-        (t[0] + t[2] * dt, t[1] + t[3] * dt)
-    }
-    fn fill(rng: &mut Rng, s: usize, buf: &mut [Plot; 512]) -> usize {
-        let mut n = scene::clutter_plots(rng, [0.0, 6000.0, 0.0, 6000.0], &mut buf[..398], |_| 1.0);
-        for i in 0..5 {
-            let (x, y) = target(i, s);
-            if let Some((x, y)) = scene::detection(rng, 0.85, x, y, 5.0) {
-                buf[n] = Plot::new(9.0, x, y);
-                n += 1;
-            }
-        }
-        n
-    }
     let det = MHT.take();
     let buf = SCAN.take();
     let mut cfg = MhtConfig::sea_clutter();
     cfg.gamma1 = 22;
     check(det.configure(&cfg, 0));
-    let mut rng = Rng::from_stream(SEED, 0);
+    let mut rng = Rng::from_stream(faint_golden::mht::COST_SEED, 0);
     for s in 0..29 {
-        let n = fill(&mut rng, s, buf);
+        let n = faint_golden::mht::cost_scan(&mut rng, s, buf);
         if s == 2 {
             check(step("MHT-TBD censoring step, scan 2 (lambda 398)", || {
                 det.step(&buf[..n])
@@ -446,7 +422,7 @@ fn mht() {
             check(r);
         }
     }
-    let n = fill(&mut rng, 29, buf);
+    let n = faint_golden::mht::cost_scan(&mut rng, 29, buf);
     check(step(
         "MHT-TBD period end: censoring + DMHT + peaks + association",
         || det.step(&buf[..n]),
