@@ -1,5 +1,5 @@
-//! The documents are tests: every command that README.md, docs/*.md, firmware/README.md
-//! and fuzz/README.md tell a user to run.
+//! The documents are tests: every command that README.md, docs/*.md,
+//! docs/measurements/*.md, firmware/README.md and fuzz/README.md tell a user to run.
 //!
 //! `cargo test` checks that every documented command is classified (a script CI runs, a
 //! synopsis, a subcommand's name, or a block the document marks `CI skips this block:
@@ -35,15 +35,20 @@ fn repo() -> PathBuf {
 /// The documents whose commands are tests.
 fn documents() -> Vec<String> {
     let mut docs = vec!["README.md".to_string()];
-    let mut family: Vec<String> = std::fs::read_dir(repo().join("docs"))
-        .expect("docs/")
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".md"))
-        .map(|n| format!("docs/{n}"))
-        .collect();
-    family.sort();
-    docs.extend(family);
+    // docs/*.md (the user guides) and docs/measurements/*.md (the measurement records).
+    for dir in ["docs", "docs/measurements"] {
+        let Ok(entries) = std::fs::read_dir(repo().join(dir)) else {
+            continue;
+        };
+        let mut pages: Vec<String> = entries
+            .filter_map(|e| e.ok())
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".md"))
+            .map(|n| format!("{dir}/{n}"))
+            .collect();
+        pages.sort();
+        docs.extend(pages);
+    }
     docs.push("firmware/README.md".into());
     docs.push("fuzz/README.md".into());
     docs
