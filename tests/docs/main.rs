@@ -20,6 +20,7 @@
 //! `FAINT_DOC_KEEP=1` keeps the scratch folders (their path is printed).
 
 mod extract;
+mod links;
 mod shims;
 
 use extract::{items, Item, Kind};
@@ -122,6 +123,47 @@ fn run_by_ci(command: &str, ci: &str) -> bool {
                 start_ok && (rest.is_empty() || ends.iter().any(|e| rest.starts_with(e)))
             })
         })
+}
+
+/// Every Markdown file of the repository (not under `target/` or a hidden folder).
+fn markdown_files(dir: &Path, rel: &str, out: &mut Vec<String>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.filter_map(|e| e.ok()) {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let path = if rel.is_empty() {
+            name.clone()
+        } else {
+            format!("{rel}/{name}")
+        };
+        if name.starts_with('.') || name == "target" {
+            continue;
+        }
+        if e.file_type().is_ok_and(|t| t.is_dir()) {
+            markdown_files(&e.path(), &path, out);
+        } else if name.ends_with(".md") {
+            out.push(path);
+        }
+    }
+}
+
+#[test]
+fn every_relative_link_resolves() {
+    let mut docs = Vec::new();
+    markdown_files(&repo(), "", &mut docs);
+    docs.sort();
+    assert!(docs.iter().any(|d| d == "README.md"), "{docs:?}");
+    let bad: Vec<String> = docs
+        .iter()
+        .flat_map(|d| links::broken(&repo(), d))
+        .collect();
+    assert!(
+        bad.is_empty(),
+        "{} broken links:\n{}",
+        bad.len(),
+        bad.join("\n")
+    );
 }
 
 #[test]
