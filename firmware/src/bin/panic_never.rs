@@ -19,6 +19,8 @@
 #[macro_use]
 mod common;
 
+faint_firmware::panic_never!();
+
 use core::hint::black_box;
 
 use cortex_m_rt::entry;
@@ -29,6 +31,7 @@ use faint_core::math;
 use faint_core::model::range_doppler::{PointModel, RdGeometry};
 use faint_core::particles::{self, Scheme};
 use faint_core::rng::Rng;
+use faint_firmware::semihosting::finish;
 
 const N: usize = 1000;
 
@@ -42,7 +45,7 @@ static mut MAP_U8: [u8; 32 * 128] = [0; 32 * 128];
 
 #[entry]
 fn main() -> ! {
-    common::finish(
+    finish(
         run(),
         b"panic-never: primitives and CbmemberTbd linked without a panic path and ran ok\n",
         b"panic-never: a primitive returned Err\n",
