@@ -1,7 +1,7 @@
 //! `SmcPhdTbd::reconfigure` restarts a filter in place exactly as `new` builds one,
 //! including from an all-zero value (how the firmware keeps the filter in `static`
 //! memory), for the three variants; and the firmware's configuration (window, capacities,
-//! particle counts of `firmware/src/phd.rs`) tracks the shared scene, so its instruction
+//! particle counts of `firmware/src/rows/phd.rs`) tracks the shared scene, so its instruction
 //! counts are those of a working filter.
 //!
 //! The all-zero value is a `const` item: the compiler's const evaluator checks that the
@@ -22,7 +22,7 @@ use faint_core::model::power_cube::CubeGeometry;
 use faint_core::rng::Rng;
 
 type Small = SmcPhdTbd<256, 256, 4, 4>;
-/// The firmware's filter (`firmware/src/phd.rs`).
+/// The firmware's filter (`firmware/src/rows/phd.rs`).
 type Firmware = SmcPhdTbd<6144, 1024, 8, 8>;
 
 // SAFETY: checked by const evaluation (an invalid all-zero field is a compile error).

@@ -24,6 +24,8 @@
 #[macro_use]
 mod common;
 
+faint_firmware::panic_never!();
+
 use core::hint::black_box;
 
 use cortex_m_rt::entry;
@@ -37,8 +39,10 @@ use faint_core::detect::{Detector, Validate};
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
 use faint_core::scene;
+use faint_firmware::semihosting::finish;
+use faint_firmware::statics::only_ref;
 
-/// The firmware's shape (`firmware/src/mht.rs`).
+/// The firmware's shape (`firmware/src/rows/mht.rs`).
 type Big = MhtTbd<512, 30, 256, 180, 16>;
 /// The golden case's shape (`golden/src/mht.rs`).
 type Small = MhtTbd<48, 10, 32, 30, 4>;
@@ -59,7 +63,7 @@ static mut PLOTS: [Plot; BUF] = [Plot::new(0.0, 0.0, 0.0); BUF];
 
 #[entry]
 fn main() -> ! {
-    common::finish(
+    finish(
         run(),
         b"panic-never-mht: MHT-TBD and the classic Hough TBD linked without a panic path and ran ok\n",
         b"panic-never-mht: a call did not return the expected Ok or Err\n",
@@ -73,14 +77,14 @@ fn run() -> bool {
     // to its static.
     let (big, small, cbig, csmall, acc, censor, flags, buf) = unsafe {
         (
-            common::only_ref(&raw mut BIG),
-            common::only_ref(&raw mut SMALL),
-            common::only_ref(&raw mut CLASSIC_BIG),
-            common::only_ref(&raw mut CLASSIC_SMALL),
-            common::only_ref(&raw mut ACC),
-            common::only_ref(&raw mut CENSOR),
-            common::only_ref(&raw mut FLAGS),
-            common::only_ref(&raw mut PLOTS),
+            only_ref(&raw mut BIG),
+            only_ref(&raw mut SMALL),
+            only_ref(&raw mut CLASSIC_BIG),
+            only_ref(&raw mut CLASSIC_SMALL),
+            only_ref(&raw mut ACC),
+            only_ref(&raw mut CENSOR),
+            only_ref(&raw mut FLAGS),
+            only_ref(&raw mut PLOTS),
         )
     };
     ok &= mht(big, &mut rng, buf);

@@ -25,6 +25,8 @@
 #[macro_use]
 mod common;
 
+faint_firmware::panic_never!();
+
 use core::hint::black_box;
 
 use cortex_m_rt::entry;
@@ -36,9 +38,11 @@ use faint_core::detect::phd::{BirthMode, SmcPhdTbd};
 use faint_core::detect::Detector;
 use faint_core::model::power_cube::CubeGeometry;
 use faint_core::rng::Rng;
+use faint_firmware::semihosting::finish;
+use faint_firmware::statics::only_ref;
 use faint_golden::phd::{config, cube, ALGORITHMS, FIRMWARE_WINDOW, GOLDEN_WINDOW};
 
-/// The firmware's shape (`firmware/src/phd.rs`).
+/// The firmware's shape (`firmware/src/rows/phd.rs`).
 type Big = SmcPhdTbd<6144, 1024, 8, 8>;
 /// The golden case's shape (`golden/src/phd.rs`).
 type Small = SmcPhdTbd<256, 256, 4, 4>;
@@ -58,7 +62,7 @@ static mut CUBE: [f32; CELLS] = [0.0; CELLS];
 
 #[entry]
 fn main() -> ! {
-    common::finish(
+    finish(
         run(),
         b"panic-never-phd: PHD-TBD, PSO-PHD-TBD (K-means) and PSO-PHD-TBD (DBSCAN) linked without a panic path and ran ok\n",
         b"panic-never-phd: a call did not return the expected Ok or Err\n",
@@ -72,13 +76,13 @@ fn run() -> bool {
     // to its static.
     let (big, small, tiny, swarm, dbscan, kmeans, buf) = unsafe {
         (
-            common::only_ref(&raw mut BIG),
-            common::only_ref(&raw mut SMALL),
-            common::only_ref(&raw mut TINY),
-            common::only_ref(&raw mut SWARM),
-            common::only_ref(&raw mut DBSCAN),
-            common::only_ref(&raw mut KMEANS),
-            common::only_ref(&raw mut CUBE),
+            only_ref(&raw mut BIG),
+            only_ref(&raw mut SMALL),
+            only_ref(&raw mut TINY),
+            only_ref(&raw mut SWARM),
+            only_ref(&raw mut DBSCAN),
+            only_ref(&raw mut KMEANS),
+            only_ref(&raw mut CUBE),
         )
     };
     // The firmware's shape and counts on its window: two scene frames per variant (the
