@@ -163,12 +163,12 @@ mod tests {
         use faint_core::detect::pf_tbd::PfTbd;
         use std::mem::size_of;
         let sizes = [
-            size_of::<crate::reproduce::mht::Mht>(),
-            size_of::<crate::reproduce::mht::Classic>(),
-            size_of::<crate::scenario::phd::HostFilter>(),
-            size_of::<crate::scenario::cbmember::HostFilter>(),
-            size_of::<crate::scenario::cbmember::HostFilterComplex>(),
-            size_of::<crate::scenario::cbmember::HostFilterU8>(),
+            size_of::<crate::instances::mht::Mht>(),
+            size_of::<crate::instances::mht::Classic>(),
+            size_of::<crate::instances::phd::HostFilter>(),
+            size_of::<crate::instances::cbmember::HostFilter>(),
+            size_of::<crate::instances::cbmember::HostFilterComplex>(),
+            size_of::<crate::instances::cbmember::HostFilterU8>(),
             size_of::<crate::scenario::dp::Arnold25>(),
             size_of::<crate::scenario::dp::Pulford25>(),
             size_of::<crate::scenario::dp::Second25>(),
@@ -206,7 +206,7 @@ mod tests {
         // The MHT-TBD of the reproduction is built on a worker, as `reproduce mht` does.
         let built = run_trials(5, 2, "mht", |_, _| {
             let cfg = faint_core::detect::mht::MhtConfig::sea_clutter();
-            crate::reproduce::mht::Mht::new(cfg).map(Box::new).is_ok()
+            crate::instances::mht::Mht::new(cfg).map(Box::new).is_ok()
         });
         assert_eq!(built, vec![true, true]);
     }

@@ -11,7 +11,7 @@ use faint::core::detect::{run, Detector, ScoreKind};
 use faint::core::model::doppler::DopplerReport;
 use faint::core::rng::Rng;
 use faint::core::Complex32;
-use faint::host::reproduce::mht::Mht;
+use faint::host::instances::mht::Mht;
 use faint::host::scenario::crpf::{Noise, Othr};
 use faint::host::scenario::mht::SeaClutter;
 

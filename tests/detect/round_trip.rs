@@ -12,12 +12,13 @@ use faint::core::detect::{run, Detector};
 use faint::core::model::doppler::{estimate_noise_variance, DopplerReport, ModelConfig};
 use faint::core::rng::Rng;
 use faint::host::detect::default_classic;
+use faint::host::instances::mht::{Classic, Mht};
+use faint::host::instances::phd::HostFilter;
 use faint::host::reproduce::crpf::run_detector;
-use faint::host::reproduce::mht::{Classic, Mht};
 use faint::host::scenario::crpf::{Noise, Othr};
 use faint::host::scenario::mht::SeaClutter;
+use faint::host::scenario::phd::SixTargets;
 use faint::host::scenario::phd::Variant;
-use faint::host::scenario::phd::{HostFilter, SixTargets};
 
 use super::{faint, s, temp};
 
@@ -525,7 +526,8 @@ fn truth_numbered_from_one() {
 fn cbmember_detectors_round_trip() {
     use faint::core::detect::cbmember::CbmemberConfig;
     use faint::core::model::range_doppler::PointModel;
-    use faint::host::scenario::cbmember::{HostFilter as Cbm, MapSource, RotorUav};
+    use faint::host::instances::cbmember::HostFilter as Cbm;
+    use faint::host::scenario::cbmember::{MapSource, RotorUav};
     let dir = temp("rt-cbm");
     let file = dir.join("maps.npy");
     let (code, _, err) = faint(&[

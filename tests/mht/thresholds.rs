@@ -9,7 +9,7 @@ use faint::core::detect::Detector;
 use faint::core::model::plot::Plot;
 use faint::core::rng::Rng;
 use faint::host::detect::{clutter_density, mht_gamma};
-use faint::host::reproduce::mht::Mht;
+use faint::host::instances::mht::Mht;
 use faint::host::scenario::mht::SeaClutter;
 
 use crate::common::{faint_quiet, temp};

@@ -27,10 +27,11 @@ use super::frames::{self, complex, len_or_short, plots, reals, Mode};
 use super::soak::{soak, Shape, Soak, WorkCounters};
 use super::{fuzz, Options, Tally, Target};
 use crate::detect::default_classic;
-use crate::reproduce::mht::{Classic, Mht, P as MHT_PLOTS};
-use crate::scenario::cbmember::HostFilter as CbmemberHost;
+use crate::instances::cbmember::HostFilter as CbmemberHost;
+use crate::instances::mht::{Classic, Mht, PLOTS as MHT_PLOTS};
+use crate::instances::phd::HostFilter as PhdHost;
 use crate::scenario::dp::{self as sdp, SIDE};
-use crate::scenario::phd::{HostFilter as PhdHost, SixTargets, Variant};
+use crate::scenario::phd::{SixTargets, Variant};
 
 /// Particles of the particle-filter detectors in a campaign (the smallest host size).
 pub const PARTICLES: usize = 1000;

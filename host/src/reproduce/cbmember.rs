@@ -28,14 +28,12 @@ use faint_core::rng::{derive_seed, Rng};
 use serde::Serialize;
 
 use crate::cli;
+use crate::instances::cbmember::{HostFilter, HostFilterU8, MAX_PARTICLES};
 use crate::io::{self, plot::Series};
 use crate::montecarlo::run_trials;
-use crate::scenario::cbmember::{HostFilter, HostFilterU8, MapKind, MapSource, RotorUav};
+use crate::scenario::cbmember::{MapKind, MapSource, RotorUav};
 use crate::stats::detection::{proportion, snr_at_pd, PdPoint, Proportion};
 use crate::stats::ospa::ospa;
-
-/// Capacity of the host filter (particles per component).
-pub const MAX_PARTICLES: usize = 1500;
 
 /// Command-line arguments of `faint reproduce cbmember`.
 #[derive(clap::Args, Debug, Clone)]

@@ -18,9 +18,10 @@ use faint_core::rng::Rng;
 use serde::Serialize;
 
 use crate::cli;
+use crate::instances::phd::HostFilter;
 use crate::io::{self, plot::Series};
 use crate::montecarlo::run_trials;
-use crate::scenario::phd::{HostFilter, SixTargets, Variant};
+use crate::scenario::phd::{SixTargets, Variant};
 use crate::stats::ospa::ospa;
 
 /// Command-line arguments.

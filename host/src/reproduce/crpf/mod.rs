@@ -8,13 +8,15 @@
 //! rate of the threshold set on the other half (calibration). The Gaussian comparators
 //! use the per-bin noise variance estimated from the run's K frames.
 //!
-//! The code is split by role: [`Args`] and its checks in `args.rs`, the thresholds and
-//! their calibration check in `calibration.rs`, the detectors' statistics, Pd versus SNR
-//! and the sweeps in `evaluation.rs`, and the CSV, SVG and Markdown outputs in
-//! `figures.rs`; [`run`] chains them.
+//! The code is split by role: [`Args`] and its checks in `args.rs`, the comparators'
+//! noise model in `comparators.rs`, the thresholds and their calibration check in
+//! `calibration.rs`, the detectors' statistics, Pd versus SNR and the sweeps in
+//! `evaluation.rs`, and the CSV, SVG and Markdown outputs in `figures.rs`; [`run`] chains
+//! them.
 
 mod args;
 mod calibration;
+mod comparators;
 mod evaluation;
 mod figures;
 
@@ -30,10 +32,8 @@ use args::Settings;
 
 pub use args::{Args, EchoPhase, PhaseModel, SceneWindow, PARTICLES};
 pub use calibration::calibration;
-pub use evaluation::{
-    batch, batch_range, run_detector, run_stats, ComparatorModel, Comparators, Likelihood, Stats,
-    VarSource, METHODS,
-};
+pub use comparators::{ComparatorModel, Comparators, Likelihood, VarSource};
+pub use evaluation::{batch, batch_range, run_detector, run_stats, Stats, METHODS};
 
 /// One Monte Carlo batch of the reproduction: its key in shard files, its runs and how
 /// they are drawn.

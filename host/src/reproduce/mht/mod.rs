@@ -19,12 +19,14 @@
 //!   whose largest count reaches `gamma`, next to the model's eq. 28.
 //!
 //! The code is split by role: [`Args`] and its checks in `args.rs`, the thresholds (the
-//! models' and the simulation's calibration of `gamma_1`) in `calibration.rs`, the trials
-//! and their scoring in `evaluation.rs`, and the CSV, SVG and Markdown outputs in
-//! `figures.rs`; [`run`] chains them.
+//! models' and the simulation's calibration of `gamma_1`) in `calibration.rs`, the two
+//! detectors built for a scene in `detectors.rs`, the trials and their scoring in
+//! `evaluation.rs`, and the CSV, SVG and Markdown outputs in `figures.rs`; [`run`] chains
+//! them.
 
 mod args;
 mod calibration;
+mod detectors;
 mod evaluation;
 mod figures;
 mod stages;
@@ -36,10 +38,8 @@ pub use calibration::{
     calibrate, false_track_counts, model_params, pilot_floor, proportion_ci, thresholds,
     thresholds_with, FalseTrackCounts, GridModel, PILOT_PERIODS,
 };
-pub use evaluation::{
-    detectors, evaluate_trial, max_count, target_plots_in, track_targets, Classic, Grid, Mht,
-    TrialStats, MATCH_TOL, NR, NS, NT, P, TR,
-};
+pub use detectors::detectors;
+pub use evaluation::{evaluate_trial, target_plots_in, track_targets, TrialStats, MATCH_TOL};
 pub use stages::{attribute, stage3_fates, Fate, Loss, StageReport};
 
 /// Entry point.
