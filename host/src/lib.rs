@@ -8,7 +8,7 @@
 //!   arrays) and merged bit for bit (`faint merge`).
 //! - [`stats`]: thresholds at a false-alarm rate, detection rates with confidence
 //!   intervals, Pd-versus-SNR crossings, ROC, OSPA, GOSPA.
-//! - [`io`]: CSV, JSON, Markdown tables and SVG plots; recorded frames and plot lists
+//! - [`io`]: CSV, JSON, Markdown tables and SVG charts; recorded frames and plot lists
 //!   read from and written to `.npy`/`.npz`/CSV.
 //! - [`scenario`]: one module per paper's scene (presets are data).
 //! - [`reproduce`]: one module per paper, behind `faint reproduce <name>`.

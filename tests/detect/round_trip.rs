@@ -85,7 +85,7 @@ fn detect_with(
         &seed,
         "--min-score",
         "-1e30",
-        "--no-plots",
+        "--no-charts",
     ];
     if let Some(c) = config {
         args.extend(["--config", s(c)]);
@@ -263,7 +263,7 @@ fn doppler_detectors_are_scale_free() {
             &seed,
             "--min-score",
             "0.5",
-            "--no-plots",
+            "--no-charts",
         ];
         if let Some(c) = cfg {
             args.extend(["--config", s(c)]);
@@ -420,7 +420,7 @@ fn printed_config_is_the_default() {
             &DET_SEED.to_string(),
             "--min-score",
             "-1e30",
-            "--no-plots",
+            "--no-charts",
         ]);
         assert_eq!(code, 0, "{err}");
         assert_eq!(read_rows(&dir.join("b/detections.csv")), a, "{name}");
@@ -493,7 +493,7 @@ fn truth_numbered_from_one() {
         ];
         let o = dir.join(out);
         args.push(s(&o));
-        args.push("--no-plots");
+        args.push("--no-charts");
         args.extend_from_slice(extra);
         let (code, _, err) = faint(&args);
         (code, err, std::fs::read_to_string(o.join("gospa.csv")).ok())

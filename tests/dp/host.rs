@@ -81,7 +81,7 @@ fn detect(name: &str, input: &Path, out: &Path, truth: &Path) -> Vec<(usize, u32
         s(out),
         "--truth",
         s(truth),
-        "--no-plots",
+        "--no-charts",
     ]);
     assert_eq!(code, 0, "{name}: {err}");
     assert!(stdout.contains("mean GOSPA"), "{stdout}");
@@ -299,7 +299,7 @@ fn ends(name: &str, input: &Path, out: &Path) -> Vec<(usize, String, String)> {
         s(input),
         "--out",
         s(out),
-        "--no-plots",
+        "--no-charts",
     ]);
     assert_eq!(code, 0, "{name}: {err}");
     let mut r = csv::Reader::from_path(out.join("detections.csv")).unwrap();

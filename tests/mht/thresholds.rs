@@ -86,7 +86,7 @@ fn thresholds_follow_the_measured_density() {
         clean.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
-        "--no-plots",
+        "--no-charts",
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(stdout.contains("gamma_1 = "), "{stdout}");
@@ -113,7 +113,7 @@ fn thresholds_follow_the_measured_density() {
         dense.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
-        "--no-plots",
+        "--no-charts",
     ]);
     assert_eq!(code, 0, "{err}");
     let warnings: Vec<&str> = err.lines().filter(|l| l.starts_with("warning:")).collect();

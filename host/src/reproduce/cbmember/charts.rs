@@ -6,7 +6,7 @@ use std::path::Path;
 use anyhow::Result;
 
 use super::evaluation::Row;
-use crate::io::{self, plot::Series};
+use crate::io::{self, chart::Series};
 
 pub(super) fn series(
     rows: &[Row],
@@ -38,7 +38,7 @@ pub(super) fn charts(d: &Path, rows: &[Row], fig11: &[usize]) -> Result<()> {
     let runs = n("base");
     let has = |set: &str| rows.iter().any(|r| r.set == set);
     if has("base") {
-        io::plot::line_chart(
+        io::chart::line_chart(
             d.join("fig7_pd.svg"),
             &format!("Fig. 7: Pd vs SNR, {runs} runs per point"),
             "SNR (dB, eq. 19)",
@@ -54,7 +54,7 @@ pub(super) fn charts(d: &Path, rows: &[Row], fig11: &[usize]) -> Result<()> {
                 series(rows, "base", "Doppler-only 1500", "Doppler-only", pd),
             ],
         )?;
-        io::plot::line_chart(
+        io::chart::line_chart(
             d.join("fig8_ospa.svg"),
             &format!("Fig. 8: mean OSPA (range m, velocity m/s; c = 5, p = 2), {runs} runs"),
             "SNR (dB, eq. 19)",
@@ -88,7 +88,7 @@ pub(super) fn charts(d: &Path, rows: &[Row], fig11: &[usize]) -> Result<()> {
             "Doppler-only 1500",
             pd,
         ));
-        io::plot::line_chart(
+        io::chart::line_chart(
             d.join("fig11_particles.svg"),
             &format!("Fig. 11: Pd vs SNR by particle count, {runs} runs"),
             "SNR (dB, eq. 19)",
@@ -97,7 +97,7 @@ pub(super) fn charts(d: &Path, rows: &[Row], fig11: &[usize]) -> Result<()> {
         )?;
     }
     if has("blades 3") {
-        io::plot::line_chart(
+        io::chart::line_chart(
             d.join("fig9_blades.svg"),
             &format!(
                 "Fig. 9: Pd vs SNR by blade count (joint 1500), {} runs (B = 2: {runs})",
@@ -113,7 +113,7 @@ pub(super) fn charts(d: &Path, rows: &[Row], fig11: &[usize]) -> Result<()> {
         )?;
     }
     if has("omega 0.04 pi") {
-        io::plot::line_chart(
+        io::chart::line_chart(
             d.join("fig10_omega.svg"),
             &format!(
                 "Fig. 10: Pd vs SNR by rotor rate (joint 1500), {} runs (0.06 pi: {runs})",
@@ -129,7 +129,7 @@ pub(super) fn charts(d: &Path, rows: &[Row], fig11: &[usize]) -> Result<()> {
         )?;
     }
     if has("ablation") {
-        io::plot::line_chart(
+        io::chart::line_chart(
             d.join("ablation_pd.svg"),
             &format!(
                 "Ablations: B estimated, u8 map (joint 1500), {} runs (base: {runs})",
@@ -152,7 +152,7 @@ pub(super) fn charts(d: &Path, rows: &[Row], fig11: &[usize]) -> Result<()> {
         )?;
     }
     if has("known") {
-        io::plot::line_chart(
+        io::chart::line_chart(
             d.join("known_pd.svg"),
             &format!(
                 "Micro-Doppler known (the paper's assumption): Pd, {} runs (base: {runs})",
@@ -180,7 +180,7 @@ pub(super) fn charts(d: &Path, rows: &[Row], fig11: &[usize]) -> Result<()> {
         )?;
     }
     if has("merge") {
-        io::plot::line_chart(
+        io::chart::line_chart(
             d.join("merge_ospa.svg"),
             &format!("Merge gate: mean OSPA, {} runs (base: {runs})", n("merge")),
             "SNR (dB, eq. 19)",
@@ -232,7 +232,7 @@ pub(super) fn charts(d: &Path, rows: &[Row], fig11: &[usize]) -> Result<()> {
             .iter()
             .map(|n| series(rows, "physical", n, n, pd))
             .collect();
-        io::plot::line_chart(
+        io::chart::line_chart(
             d.join("physical_pd.svg"),
             &format!(
                 "Physical generator (eq. 11 + FFT): Pd vs SNR, {} runs",
@@ -244,7 +244,7 @@ pub(super) fn charts(d: &Path, rows: &[Row], fig11: &[usize]) -> Result<()> {
         )?;
     }
     if has("target-free") {
-        io::plot::line_chart(
+        io::chart::line_chart(
             d.join("false_alarms.svg"),
             &format!(
                 "Target-free runs: reported components per frame, {} runs",

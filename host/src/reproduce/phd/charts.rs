@@ -6,7 +6,7 @@ use std::path::Path;
 use anyhow::Result;
 
 use super::evaluation::FrameRow;
-use crate::io::{self, plot::Series};
+use crate::io::{self, chart::Series};
 use crate::scenario::phd::Variant;
 
 /// The three charts of one SNR from its per-frame rows `frames` (every variant's, in
@@ -39,21 +39,21 @@ pub(super) fn charts(
         std_series.push(series(|r| r.std_count));
         ospa_series.push(series(|r| r.mean_ospa));
     }
-    io::plot::line_chart(
+    io::chart::line_chart(
         d.join(format!("count_{snr}db.svg")),
         &format!("Mean estimated target count, {snr} dB, {runs} runs (Fig. 3)"),
         "frame",
         "count",
         &count_series,
     )?;
-    io::plot::line_chart(
+    io::chart::line_chart(
         d.join(format!("count_std_{snr}db.svg")),
         &format!("Std of the estimated count, {snr} dB, {runs} runs (Fig. 4)"),
         "frame",
         "std",
         &std_series,
     )?;
-    io::plot::line_chart(
+    io::chart::line_chart(
         d.join(format!("ospa_{snr}db.svg")),
         &format!("Mean OSPA (c = 50 m, p = 2), {snr} dB, {runs} runs (Fig. 5)"),
         "frame",
