@@ -13,7 +13,7 @@ use faint::core::model::range_doppler::{
 };
 use faint::core::rng::Rng;
 use faint::host::instances::cbmember::HostFilter;
-use faint::host::scenario::cbmember::{MapSource, RotorUav};
+use faint::host::simulate::cbmember::{MapSource, RotorUav};
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();

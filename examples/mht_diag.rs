@@ -26,7 +26,7 @@ use faint_core::rng::Rng;
 use faint_host::analysis::mht::{CellModel, ChainSource, CompoundModel};
 use faint_host::instances::mht::{ANGLE_CELLS, RANGE_CELLS};
 use faint_host::reproduce::mht::{detectors, model_params, thresholds, MATCH_TOL};
-use faint_host::scenario::mht::{Origin, SeaClutter};
+use faint_host::simulate::mht::{Origin, SeaClutter};
 
 fn false_tracks(a: &[String]) {
     let lambda: f32 = a.get(2).and_then(|s| s.parse().ok()).unwrap_or(164.0);
@@ -153,7 +153,7 @@ fn lost_targets(a: &[String]) {
         .unwrap_or_else(|| thresholds(&sc, 1e-4).0 as u8);
     let n = sc.n_scans;
     let found = |m: &faint_host::instances::mht::Mht,
-                 tg: &faint_host::scenario::mht::TargetTruth| {
+                 tg: &faint_host::simulate::mht::TargetTruth| {
         m.tracks().iter().position(|trk| {
             let (co, si) = (trk.theta.cos(), trk.theta.sin());
             (0..n).all(|s| {

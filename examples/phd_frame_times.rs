@@ -13,7 +13,7 @@
 use faint_core::detect::Detector;
 use faint_core::rng::Rng;
 use faint_host::instances::phd::HostFilter;
-use faint_host::scenario::phd::{SixTargets, Variant};
+use faint_host::simulate::phd::{SixTargets, Variant};
 
 /// This thread's CPU time in ns (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`, exact to the
 /// ns; `/proc/thread-self/schedstat`, used by the bench for the mean, only advances at

@@ -147,7 +147,7 @@ struct SimulateArgs {
     speed: Option<u8>,
     /// Background noise (othr).
     #[arg(long, value_enum, default_value = "gaussian")]
-    noise: faint::host::scenario::crpf::Noise,
+    noise: faint::host::simulate::crpf::Noise,
 }
 
 #[derive(Subcommand, Debug)]
@@ -169,13 +169,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     faint::host::montecarlo::set_quiet(cli.quiet);
     match cli.command {
         Command::Scenarios => {
-            for (name, about) in faint::host::scenario::catalogue() {
+            for (name, about) in faint::host::simulate::catalogue() {
                 println!("{name:14} {about}");
             }
             Ok(())
         }
         Command::Scenario { name } => {
-            let v = faint::host::scenario::describe(&name)?;
+            let v = faint::host::simulate::describe(&name)?;
             println!("{}", serde_json::to_string_pretty(&v)?);
             Ok(())
         }

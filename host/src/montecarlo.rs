@@ -55,10 +55,10 @@ pub fn progress_bar(label: &str, n: usize) -> ProgressBar {
 pub const STACK_COPIES: usize = 8;
 
 /// The largest detector the host builds by value, in bytes: the second-order DP-TBD of
-/// the DP reproduction (`scenario::dp::Second25`, 6.3 MB); the PHD host filter is 3.1 MB.
+/// the DP reproduction (`simulate::dp::Second25`, 6.3 MB); the PHD host filter is 3.1 MB.
 /// A unit test checks this bound against `size_of` of every detector type the host builds
-/// by value. The larger DP detectors of `faint detect` (`scenario::dp::*At256`,
-/// `*At512`, up to 100 MB) are never built by value: `scenario::dp::boxed` zeroes and
+/// by value. The larger DP detectors of `faint detect` (`simulate::dp::*At256`,
+/// `*At512`, up to 100 MB) are never built by value: `simulate::dp::boxed` zeroes and
 /// configures them in place on the heap (tested on a 256 KiB stack).
 pub const LARGEST_DETECTOR: usize = 7 << 20;
 
@@ -169,9 +169,9 @@ mod tests {
             size_of::<crate::instances::cbmember::HostFilter>(),
             size_of::<crate::instances::cbmember::HostFilterComplex>(),
             size_of::<crate::instances::cbmember::HostFilterU8>(),
-            size_of::<crate::scenario::dp::Arnold25>(),
-            size_of::<crate::scenario::dp::Pulford25>(),
-            size_of::<crate::scenario::dp::Second25>(),
+            size_of::<crate::simulate::dp::Arnold25>(),
+            size_of::<crate::simulate::dp::Pulford25>(),
+            size_of::<crate::simulate::dp::Second25>(),
             size_of::<crate::reliability::guided::Phd>(),
             size_of::<crate::reliability::guided::Cbm>(),
             size_of::<crate::reliability::guided::Second25>(),

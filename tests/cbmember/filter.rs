@@ -15,7 +15,7 @@ use faint::core::model::range_doppler::{
 use faint::core::rng::Rng;
 use faint::core::{Complex32, Error};
 use faint::host::instances::cbmember::HostFilter;
-use faint::host::scenario::cbmember::{MapSource, RotorUav};
+use faint::host::simulate::cbmember::{MapSource, RotorUav};
 use proptest::prelude::*;
 
 /// `f64` brute force of eq. 22 over every pixel of the map: `a_ij = A sum_p g_p(i, j)`

@@ -15,10 +15,10 @@ use faint::host::detect::default_classic;
 use faint::host::instances::mht::{Classic, Mht};
 use faint::host::instances::phd::HostFilter;
 use faint::host::reproduce::crpf::run_detector;
-use faint::host::scenario::crpf::{Noise, Othr};
-use faint::host::scenario::mht::SeaClutter;
-use faint::host::scenario::phd::SixTargets;
-use faint::host::scenario::phd::Variant;
+use faint::host::simulate::crpf::{Noise, Othr};
+use faint::host::simulate::mht::SeaClutter;
+use faint::host::simulate::phd::SixTargets;
+use faint::host::simulate::phd::Variant;
 
 use super::{faint, s, temp};
 
@@ -527,7 +527,7 @@ fn cbmember_detectors_round_trip() {
     use faint::core::detect::cbmember::CbmemberConfig;
     use faint::core::model::range_doppler::PointModel;
     use faint::host::instances::cbmember::HostFilter as Cbm;
-    use faint::host::scenario::cbmember::{MapSource, RotorUav};
+    use faint::host::simulate::cbmember::{MapSource, RotorUav};
     let dir = temp("rt-cbm");
     let file = dir.join("maps.npy");
     let (code, _, err) = faint(&[

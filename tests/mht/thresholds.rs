@@ -10,7 +10,7 @@ use faint::core::model::plot::Plot;
 use faint::core::rng::Rng;
 use faint::host::detect::{clutter_density, mht_gamma};
 use faint::host::instances::mht::Mht;
-use faint::host::scenario::mht::SeaClutter;
+use faint::host::simulate::mht::SeaClutter;
 
 use crate::common::{faint_quiet, temp};
 
@@ -36,7 +36,7 @@ fn mht_gamma_holds_its_rate_on_fresh_clutter() {
         m.configure(&at, 0).unwrap();
         let mut tracks = 0;
         for _ in 0..cfg.n_scans {
-            let k = faint::host::scenario::mht::poisson(&mut rng, sc.lambda);
+            let k = faint::host::simulate::mht::poisson(&mut rng, sc.lambda);
             let plots: Vec<Plot> = (0..k)
                 .map(|_| Plot::new(1.0, rng.uniform_range(x0, x1), rng.uniform_range(y0, y1)))
                 .collect();

@@ -6,7 +6,7 @@ use faint::core::detect::Detector;
 use faint::core::rng::Rng;
 use faint::core::Error;
 use faint::host::instances::phd::HostFilter;
-use faint::host::scenario::phd::{SixTargets, Variant};
+use faint::host::simulate::phd::{SixTargets, Variant};
 use faint::host::stats::ospa::ospa;
 
 /// The host filter is ~5 MB of fixed arrays: run on a thread with a big stack.

@@ -20,7 +20,7 @@ use faint::host::instances::mht::Mht;
 use faint::host::instances::phd::HostFilter;
 use faint::host::reliability::check_outputs;
 use faint::host::reliability::targets::small_phd;
-use faint::host::scenario::phd::Variant;
+use faint::host::simulate::phd::Variant;
 
 /// Runs `f` on a thread with a 256 MB stack (the host filters are large values).
 fn big_stack<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {

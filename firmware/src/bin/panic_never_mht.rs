@@ -36,7 +36,7 @@ use faint_core::detect::mht::{
 use faint_core::detect::{Detector, Validate};
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
-use faint_core::scene;
+use faint_core::simulate;
 
 /// The firmware's shape (`firmware/src/mht.rs`).
 type Big = MhtTbd<512, 30, 256, 180, 16>;
@@ -139,7 +139,7 @@ fn make_scan(
     let Some(out) = buf.get_mut(..n) else {
         return 0;
     };
-    let mut n = scene::clutter_plots(rng, area, out, |r| 1.0 + r.uniform());
+    let mut n = simulate::clutter_plots(rng, area, out, |r| 1.0 + r.uniform());
     if kind == Kind::Empty || kind == Kind::Overflow {
         return n;
     }
@@ -157,7 +157,7 @@ fn make_scan(
         (area[0] + 0.5 * w, area[3] - 0.1 * h - 0.02 * h * t),
     ];
     for (x, y) in targets {
-        if let Some((x, y)) = scene::detection(rng, 0.9, x, y, 0.002 * w) {
+        if let Some((x, y)) = simulate::detection(rng, 0.9, x, y, 0.002 * w) {
             if let Some(p) = buf.get_mut(n) {
                 *p = Plot::new(5.0, x, y);
                 n += 1;

@@ -12,7 +12,7 @@ use super::{drive, find_default, json, load, valid, InputView, Outcome, Request,
 use crate::analysis::mht::{classic_gamma, max_count};
 use crate::instances::mht::{Classic, Mht, ANGLE_CELLS, RANGE_CELLS, SCANS};
 use crate::io::input::read_plots;
-use crate::scenario::mht::SeaClutter;
+use crate::simulate::mht::SeaClutter;
 use crate::stats::noise::median;
 use crate::timing::thread_cpu_seconds as cpu;
 
@@ -84,7 +84,7 @@ pub fn mht_gamma(config: &MhtConfig, lambda: f64, pfa: f64, seed: u64) -> Result
             m.configure(&step_cfg, 0).map_err(|e| anyhow!("{e}"))?;
             let mut with = vec![false; n + 2];
             for _ in 0..n {
-                let k = crate::scenario::mht::poisson(rng, lambda as f32);
+                let k = crate::simulate::mht::poisson(rng, lambda as f32);
                 let plots: Vec<Plot> = (0..k)
                     .map(|_| Plot::new(1.0, rng.uniform_range(x0, x1), rng.uniform_range(y0, y1)))
                     .collect();

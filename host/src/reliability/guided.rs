@@ -59,7 +59,7 @@ use super::frames::{self, complex, len_or_short, plots, reals, Mode, BAD, EXTREM
 use super::mutate::{FLOATS, INTS};
 use super::{check_outputs, outputs, twin_check, Kind};
 use crate::instances::mht::{Classic, Mht, PLOTS as MHT_PLOTS};
-use crate::scenario::phd::{SixTargets, Variant};
+use crate::simulate::phd::{SixTargets, Variant};
 
 /// What one input did (for the fuzz targets' statistics and the replay tests).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]

@@ -30,8 +30,8 @@ use crate::detect::default_classic;
 use crate::instances::cbmember::HostFilter as CbmemberHost;
 use crate::instances::mht::{Classic, Mht, PLOTS as MHT_PLOTS};
 use crate::instances::phd::HostFilter as PhdHost;
-use crate::scenario::dp::{self as sdp, SIDE};
-use crate::scenario::phd::{SixTargets, Variant};
+use crate::simulate::dp::{self as sdp, SIDE};
+use crate::simulate::phd::{SixTargets, Variant};
 
 /// Particles of the particle-filter detectors in a campaign (the smallest host size).
 pub const PARTICLES: usize = 1000;
@@ -160,7 +160,7 @@ type Second32 = SecondOrderDp<
     { second_order_words(REDUCED_SIDE, 9, sdp::HISTORY) },
 >;
 
-// SAFETY: the same types as `scenario::dp`'s (integers, floats, bools, fieldless enums
+// SAFETY: the same types as `simulate::dp`'s (integers, floats, bools, fieldless enums
 // whose first variant is 0), on a smaller image: their `unconfigured()` is all zeros.
 unsafe impl sdp::ZeroValid for Arnold32 {}
 // SAFETY: as above.

@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use crate::instances::cbmember::{HostFilter, HostFilterU8};
 use crate::montecarlo::run_trials;
-use crate::scenario::cbmember::{MapSource, RotorUav};
+use crate::simulate::cbmember::{MapSource, RotorUav};
 use crate::stats::detection::{proportion, PdPoint, Proportion};
 use crate::stats::ospa::ospa;
 

@@ -32,7 +32,7 @@ use anyhow::{Context, Result};
 
 use crate::cli;
 use crate::io;
-use crate::scenario::cbmember::{MapKind, RotorUav};
+use crate::simulate::cbmember::{MapKind, RotorUav};
 use evaluation::{doppler, joint, matched, run_set, FilterSpec, Input};
 
 pub use args::{Args, SETS};

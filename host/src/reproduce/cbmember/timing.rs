@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use super::paper;
 use crate::instances::cbmember::HostFilter;
-use crate::scenario::cbmember::{MapSource, RotorUav};
+use crate::simulate::cbmember::{MapSource, RotorUav};
 
 /// Table 3 timing row.
 #[derive(Debug, Clone, Serialize)]

@@ -7,8 +7,8 @@ use anyhow::{ensure, Result};
 
 use super::comparators::{ComparatorModel, Likelihood, VarSource};
 use crate::cli;
-use crate::scenario::crpf::{Noise, Othr};
 use crate::shard::ShardArg;
+use crate::simulate::crpf::{Noise, Othr};
 use faint_core::detect::pf_tbd::BirthProposal;
 use faint_core::model::doppler::{Phase, Window};
 use serde::{Deserialize, Serialize};

@@ -20,7 +20,7 @@ use serde::{Deserialize, Serialize};
 use super::args::Settings;
 use super::comparators::{ComparatorModel, Comparators, Likelihood, VarSource};
 use crate::montecarlo::run_trial_range;
-use crate::scenario::crpf::{Noise, Othr, Run};
+use crate::simulate::crpf::{Noise, Othr, Run};
 use crate::stats::detection::{detection_rate, snr_at_pd, threshold_at_pfa, PdPoint};
 
 /// Names of the five test statistics, in [`Stats::values`] order.

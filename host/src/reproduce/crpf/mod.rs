@@ -26,8 +26,8 @@ use anyhow::Result;
 use faint_core::detect::crpf::CrpfConfig;
 use faint_core::rng::derive_seed;
 
-use crate::scenario::crpf::{Noise, Othr};
 use crate::shard::{self, Batch, Merged, Run, Shard};
+use crate::simulate::crpf::{Noise, Othr};
 use args::Settings;
 
 pub use args::{Args, EchoPhase, PhaseModel, SceneWindow, PARTICLES};

@@ -10,7 +10,7 @@ use super::args::Settings;
 use super::calibration::Thresholds;
 use super::evaluation::{PdCurves, SnrRow, Stats, Sweeps, METHODS};
 use crate::io::{self, chart};
-use crate::scenario::crpf::Noise;
+use crate::simulate::crpf::Noise;
 
 /// H0 outputs: `h0_stats.csv`, `calibration.csv` and Fig. 1 (H0 histograms of the
 /// existence statistics).

@@ -31,7 +31,7 @@ use crate::analysis::dp::track_thresholds;
 use crate::cli;
 use crate::io::{self, chart::Series};
 use crate::montecarlo::run_trials;
-use crate::scenario::dp::{DimPoint, HISTORY, METHODS};
+use crate::simulate::dp::{DimPoint, HISTORY, METHODS};
 use crate::stats::detection::{proportion, threshold_at_pfa, Proportion};
 
 pub mod eval;

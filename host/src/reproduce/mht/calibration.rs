@@ -13,7 +13,7 @@ use crate::analysis::mht::{
     self as model, max_count, CellModel, ChainSource, CompoundModel, ModelParams,
 };
 use crate::instances::mht::{ANGLE_CELLS, RANGE_CELLS};
-use crate::scenario::mht::SeaClutter;
+use crate::simulate::mht::SeaClutter;
 
 /// Clutter-only false-track counts per candidate `gamma_1` (index = `gamma_1`).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]

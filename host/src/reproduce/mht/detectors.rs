@@ -3,7 +3,7 @@
 use faint_core::detect::mht::{ClassicHoughConfig, MhtConfig};
 
 use crate::instances::mht::{Classic, Mht};
-use crate::scenario::mht::SeaClutter;
+use crate::simulate::mht::SeaClutter;
 
 /// Build the two detectors for a lambda and its thresholds.
 pub fn detectors(

@@ -10,7 +10,7 @@ use super::calibration::{model_params, proportion_ci, Gammas, GridModel};
 use super::detectors::detectors;
 use crate::analysis::mht::{self as model, max_count, CellModel, ChainSource, CompoundModel};
 use crate::instances::mht::{Classic, Mht, SCANS};
-use crate::scenario::mht::{Origin, SeaClutter, Trial};
+use crate::simulate::mht::{Origin, SeaClutter, Trial};
 
 /// Line-to-truth tolerance (m).
 pub const MATCH_TOL: f32 = 60.0;

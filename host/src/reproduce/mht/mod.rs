@@ -31,7 +31,7 @@ mod evaluation;
 mod outputs;
 mod stages;
 
-use crate::scenario::mht::SeaClutter;
+use crate::simulate::mht::SeaClutter;
 
 pub use args::{Args, CalibRule, GammaFrom, ModelChoice};
 pub use calibration::{

@@ -30,7 +30,7 @@ use faint_core::rng::Rng;
 use super::detectors::detectors;
 use super::evaluation::{target_plots_in, track_targets};
 use crate::instances::mht::{Mht, ANGLE_CELLS, PLOTS, RANGE_CELLS, SCANS, TRACKS};
-use crate::scenario::mht::{Origin, SeaClutter, Trial};
+use crate::simulate::mht::{Origin, SeaClutter, Trial};
 
 /// What stage 3 did with one peak (peaks are taken strongest first).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -7,7 +7,7 @@ use anyhow::Result;
 
 use crate::cli;
 use crate::instances::phd::HostFilter;
-use crate::scenario::phd::{SixTargets, Variant};
+use crate::simulate::phd::{SixTargets, Variant};
 
 /// Command-line arguments.
 #[derive(clap::Args, Debug, Clone)]

@@ -7,7 +7,7 @@ use anyhow::Result;
 
 use super::evaluation::FrameRow;
 use crate::io::{self, chart::Series};
-use crate::scenario::phd::Variant;
+use crate::simulate::phd::Variant;
 
 /// The three charts of one SNR from its per-frame rows `frames` (every variant's, in
 /// `variants` order) and the true count per frame.

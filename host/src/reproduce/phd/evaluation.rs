@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use crate::instances::phd::HostFilter;
 use crate::montecarlo::run_trials;
-use crate::scenario::phd::{SixTargets, Variant};
+use crate::simulate::phd::{SixTargets, Variant};
 use crate::stats::ospa::ospa;
 
 /// One run of one variant.

@@ -293,7 +293,7 @@ impl SixTargets {
                 .for_each_cell(&g, &c, |idx, h| cells.push((idx, a * h)));
         }
         let mut order = vec![0u32; cells.len()];
-        faint_core::scene::cube_returns(cube, &mut cells, &mut order, s2, rng);
+        faint_core::simulate::cube_returns(cube, &mut cells, &mut order, s2, rng);
     }
 
     /// Filter configuration for `variant`.
