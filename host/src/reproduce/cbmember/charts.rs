@@ -5,7 +5,7 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use super::evaluation::Row;
+use super::evaluation::{runs_per_point, Row};
 use crate::io::{self, chart::Series};
 
 pub(super) fn series(
@@ -27,14 +27,7 @@ pub(super) fn series(
 
 pub(super) fn charts(d: &Path, rows: &[Row], fig11: &[usize]) -> Result<()> {
     let pd = |r: &Row| r.pd;
-    // Runs per point of a set (the sets of a merged run can differ).
-    let n = |set: &str| {
-        rows.iter()
-            .filter(|r| r.set == set)
-            .map(|r| r.runs)
-            .max()
-            .unwrap_or(0)
-    };
+    let n = |set: &str| runs_per_point(rows, set);
     let runs = n("base");
     let has = |set: &str| rows.iter().any(|r| r.set == set);
     if has("base") {

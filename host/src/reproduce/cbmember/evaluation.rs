@@ -271,3 +271,12 @@ pub(super) fn curve(rows: &[Row], set: &str, name: &str) -> Vec<PdPoint> {
         })
         .collect()
 }
+
+/// Runs per point of `set` (the sets of a run merged with `--previous` can differ).
+pub(super) fn runs_per_point(rows: &[Row], set: &str) -> usize {
+    rows.iter()
+        .filter(|r| r.set == set)
+        .map(|r| r.runs)
+        .max()
+        .unwrap_or(0)
+}

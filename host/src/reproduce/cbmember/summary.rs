@@ -1,6 +1,6 @@
 //! The Markdown summary of `faint reproduce cbmember`: our numbers next to the paper's.
 
-use super::evaluation::{curve, Row};
+use super::evaluation::{curve, runs_per_point, Row};
 use super::paper;
 use super::timing::TimingRow;
 use crate::io;
@@ -13,13 +13,7 @@ fn fmt_db(x: Option<f64>) -> String {
 /// The Markdown summary: our numbers next to the paper's.
 pub(super) fn summary(rows: &[Row], timing: &[TimingRow]) -> String {
     let mut s = String::new();
-    let n = |set: &str| {
-        rows.iter()
-            .filter(|r| r.set == set)
-            .map(|r| r.runs)
-            .max()
-            .unwrap_or(0)
-    };
+    let n = |set: &str| runs_per_point(rows, set);
     let runs = n("base");
     let at = |set: &str, name: &str, lvl: f64| snr_at_pd(&curve(rows, set, name), lvl);
     if rows.iter().any(|r| r.set == "base") {
