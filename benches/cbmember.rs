@@ -12,7 +12,8 @@ use faint::core::detect::cbmember::Likelihood;
 use faint::core::detect::Detector;
 use faint::core::model::range_doppler::{quantise, Dequant, PointModel};
 use faint::core::rng::Rng;
-use faint::host::scenario::cbmember::{HostFilter, HostFilterU8, MapSource, RotorUav};
+use faint::host::instances::cbmember::{HostFilter, HostFilterU8};
+use faint::host::simulate::cbmember::{MapSource, RotorUav};
 
 const ROWS: [(&str, PointModel, usize); 4] = [
     ("doppler_only_1500", PointModel::DopplerOnly, 1500),

@@ -13,7 +13,7 @@ use faint::core::detect::{run, Detector};
 use faint::core::model::doppler::{estimate_noise_variance, DopplerReport};
 use faint::core::rng::Rng;
 use faint::core::Complex32;
-use faint::host::scenario::crpf::{Noise, Othr};
+use faint::host::simulate::crpf::{Noise, Othr};
 use std::hint::black_box;
 
 fn run_all<D: Detector<Frame = [Complex32], Report = DopplerReport>>(

@@ -6,7 +6,7 @@ use faint::core::detect::mht::Geometry;
 use faint::core::detect::Detector;
 use faint::core::rng::Rng;
 use faint::host::reproduce::mht::{detectors, thresholds};
-use faint::host::scenario::mht::SeaClutter;
+use faint::host::simulate::mht::SeaClutter;
 use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {

@@ -7,7 +7,8 @@ use criterion::{criterion_group, BatchSize, Criterion};
 use faint::core::detect::phd::{Dbscan, DbscanParams};
 use faint::core::detect::Detector;
 use faint::core::rng::Rng;
-use faint::host::scenario::phd::{HostFilter, SixTargets, Variant};
+use faint::host::instances::phd::HostFilter;
+use faint::host::simulate::phd::{SixTargets, Variant};
 
 fn bench_phd(c: &mut Criterion) {
     let sc = SixTargets::new(9.0);

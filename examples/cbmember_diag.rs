@@ -12,7 +12,8 @@ use faint::core::model::range_doppler::{
     log_lr_blocked, log_lr_exact, peak_snr, BlockMap, Dequant, Kernel, PointModel,
 };
 use faint::core::rng::Rng;
-use faint::host::scenario::cbmember::{HostFilter, MapSource, RotorUav};
+use faint::host::instances::cbmember::HostFilter;
+use faint::host::simulate::cbmember::{MapSource, RotorUav};
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();

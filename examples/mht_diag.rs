@@ -24,8 +24,9 @@
 use faint_core::detect::Detector;
 use faint_core::rng::Rng;
 use faint_host::analysis::mht::{CellModel, ChainSource, CompoundModel};
-use faint_host::reproduce::mht::{detectors, model_params, thresholds, MATCH_TOL, NR, NT};
-use faint_host::scenario::mht::{Origin, SeaClutter};
+use faint_host::instances::mht::{ANGLE_CELLS, RANGE_CELLS};
+use faint_host::reproduce::mht::{detectors, model_params, thresholds, MATCH_TOL};
+use faint_host::simulate::mht::{Origin, SeaClutter};
 
 fn false_tracks(a: &[String]) {
     let lambda: f32 = a.get(2).and_then(|s| s.parse().ok()).unwrap_or(164.0);
@@ -151,8 +152,8 @@ fn lost_targets(a: &[String]) {
         .and_then(|s| s.parse().ok())
         .unwrap_or_else(|| thresholds(&sc, 1e-4).0 as u8);
     let n = sc.n_scans;
-    let found = |m: &faint_host::reproduce::mht::Mht,
-                 tg: &faint_host::scenario::mht::TargetTruth| {
+    let found = |m: &faint_host::instances::mht::Mht,
+                 tg: &faint_host::simulate::mht::TargetTruth| {
         m.tracks().iter().position(|trk| {
             let (co, si) = (trk.theta.cos(), trk.theta.sin());
             (0..n).all(|s| {
@@ -368,8 +369,8 @@ fn main() {
         drho_sum += f64::from(g.drho());
         let acc = m.accumulator();
         let mut best = (0u8, 0usize, 0usize);
-        for aa in 0..NT {
-            for r in 0..NR {
+        for aa in 0..ANGLE_CELLS {
+            for r in 0..RANGE_CELLS {
                 let c = acc.count(r, aa);
                 hist[usize::from(c)] += 1;
                 if c > best.0 {
@@ -410,7 +411,7 @@ fn main() {
         hits_sum += hit.iter().filter(|h| **h).count() as u64;
     }
     let tf = trials as f64;
-    let cells = (NR * NT) as f64 * tf;
+    let cells = (RANGE_CELLS * ANGLE_CELLS) as f64 * tf;
     println!(
         "lambda {lambda} trials {trials}: mean DMHT drho {:.2} m, effective plots/scan {:.2}, model p_ch {:.4}, N_c {}, m0-model p0_cross {:.4}",
         drho_sum / tf,

@@ -4,7 +4,8 @@
 use faint_core::detect::Detector;
 use faint_core::model::power_cube::{PowerCube, RadarCoords};
 use faint_core::rng::Rng;
-use faint_host::scenario::phd::{HostFilter, SixTargets, Variant};
+use faint_host::instances::phd::HostFilter;
+use faint_host::simulate::phd::{SixTargets, Variant};
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();

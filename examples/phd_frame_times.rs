@@ -12,7 +12,8 @@
 //! core on a loaded machine is not counted (Linux x86_64 / aarch64 only).
 use faint_core::detect::Detector;
 use faint_core::rng::Rng;
-use faint_host::scenario::phd::{HostFilter, SixTargets, Variant};
+use faint_host::instances::phd::HostFilter;
+use faint_host::simulate::phd::{SixTargets, Variant};
 
 /// This thread's CPU time in ns (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`, exact to the
 /// ns; `/proc/thread-self/schedstat`, used by the bench for the mean, only advances at

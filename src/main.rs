@@ -32,7 +32,7 @@ enum Command {
         /// Preset name, as listed by `faint scenarios`.
         name: String,
     },
-    /// Reproduce a paper's figures and tables (CSV, SVG plots, Markdown table).
+    /// Reproduce a paper's figures and tables (CSV, SVG charts, Markdown table).
     #[command(subcommand)]
     Reproduce(Reproduce),
     /// Run a detector on recorded frames (a .npy/.npz array or a CSV plot list).
@@ -106,9 +106,9 @@ struct DetectArgs {
     /// Also write every frame's full report (`reports.json`).
     #[arg(long)]
     reports: bool,
-    /// Skip the SVG plots.
-    #[arg(long)]
-    no_plots: bool,
+    /// Skip the SVG charts (`--no-plots` is an alias).
+    #[arg(long, alias = "no-plots")]
+    no_charts: bool,
     /// List the detectors with their input kind.
     #[arg(long)]
     list: bool,
@@ -147,7 +147,7 @@ struct SimulateArgs {
     speed: Option<u8>,
     /// Background noise (othr).
     #[arg(long, value_enum, default_value = "gaussian")]
-    noise: faint::host::scenario::crpf::Noise,
+    noise: faint::host::simulate::crpf::Noise,
 }
 
 #[derive(Subcommand, Debug)]
@@ -169,13 +169,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     faint::host::montecarlo::set_quiet(cli.quiet);
     match cli.command {
         Command::Scenarios => {
-            for (name, about) in faint::host::scenario::catalogue() {
+            for (name, about) in faint::host::simulate::catalogue() {
                 println!("{name:14} {about}");
             }
             Ok(())
         }
         Command::Scenario { name } => {
-            let v = faint::host::scenario::describe(&name)?;
+            let v = faint::host::simulate::describe(&name)?;
             println!("{}", serde_json::to_string_pretty(&v)?);
             Ok(())
         }
@@ -397,10 +397,10 @@ fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
     let w = detect::write(&outcome, &out_dir, select, truth.as_deref(), c)?;
     let write_seconds = faint::host::timing::thread_cpu_seconds() - t;
     let t = faint::host::timing::thread_cpu_seconds();
-    if !a.no_plots {
-        detect::write_plots(&outcome, &out_dir, select)?;
+    if !a.no_charts {
+        detect::write_charts(&outcome, &out_dir, select)?;
     }
-    let plot_seconds = faint::host::timing::thread_cpu_seconds() - t;
+    let chart_seconds = faint::host::timing::thread_cpu_seconds() - t;
     let rule = match &calibration {
         Some(c) => format!(
             "above the thresholds at Pfa {} per frame from frame {}",
@@ -422,12 +422,12 @@ fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
         eprintln!("warning: {w}");
     }
     println!(
-        "CPU time: read {:.4} s, detector {:.4} s, collecting {:.4} s, writing {:.4} s, plots {:.4} s",
+        "CPU time: read {:.4} s, detector {:.4} s, collecting {:.4} s, writing {:.4} s, charts {:.4} s",
         outcome.read_seconds,
         outcome.detector_seconds,
         outcome.collect_seconds,
         write_seconds,
-        plot_seconds
+        chart_seconds
     );
     if let Some(g) = w.mean_gospa {
         println!("mean GOSPA (c = {c}, p = 2, alpha = 2): {g:.4}");

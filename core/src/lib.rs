@@ -16,14 +16,14 @@
 //! use faint_core::detect::{run, Detector};
 //! use faint_core::model::plot::Plot;
 //! use faint_core::rng::Rng;
-//! use faint_core::scene;
+//! use faint_core::simulate;
 //!
 //! // 30 scans of 60 clutter plots and one target moving 20 m per scan (6 km x 6 km).
 //! let mut rng = Rng::seed_from_u64(1);
 //! let scans: Vec<Vec<Plot>> = (0..30)
 //!     .map(|s| {
 //!         let mut plots = vec![Plot::new(0.0, 0.0, 0.0); 60];
-//!         scene::clutter_plots(&mut rng, [0.0, 6000.0, 0.0, 6000.0], &mut plots, |_| 1.0);
+//!         simulate::clutter_plots(&mut rng, [0.0, 6000.0, 0.0, 6000.0], &mut plots, |_| 1.0);
 //!         plots.push(Plot::new(5.0, 1000.0 + 20.0 * s as f32, 2000.0 + 10.0 * s as f32));
 //!         plots
 //!     })
@@ -54,8 +54,8 @@
 //! - [`statistic`]: test statistics over K frames (`zeta_K`, `D_K`).
 //! - [`sort`]: a panic-free in-place unstable sort (introsort) for the detectors the
 //!   panic-never link checks cover.
-//! - [`scene`]: allocation-free scene synthesis (clutter plots, detections, power-cube
-//!   returns) shared by the host simulators, the golden cases and the firmware.
+//! - [`simulate`]: allocation-free simulation of scenes (clutter plots, detections,
+//!   power-cube returns) shared by the host simulators, the golden cases and the firmware.
 //! - [`Complex32`]: complex samples, from `num-complex`.
 #![no_std]
 // `unsafe` only in the Cortex-M4 `asm!` blocks of `detect::dp` (each with its SAFETY note).
@@ -76,7 +76,7 @@ pub mod math;
 pub mod model;
 pub mod particles;
 pub mod rng;
-pub mod scene;
+pub mod simulate;
 pub mod sort;
 pub mod statistic;
 

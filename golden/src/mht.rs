@@ -7,7 +7,7 @@ use faint_core::detect::mht::{ClassicHough, ClassicHoughConfig, MhtConfig, MhtTb
 use faint_core::detect::Detector;
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
-use faint_core::scene;
+use faint_core::simulate;
 
 type Det = MhtTbd<48, 10, 32, 30, 4>;
 
@@ -39,10 +39,10 @@ fn cost_target(i: usize, s: usize) -> (f32, f32) {
 /// (`out` needs `COST_CLUTTER + 5` plots; a shorter one gets fewer).
 pub fn cost_scan(rng: &mut Rng, s: usize, out: &mut [Plot]) -> usize {
     let k = COST_CLUTTER.min(out.len());
-    let mut n = scene::clutter_plots(rng, [0.0, 6000.0, 0.0, 6000.0], &mut out[..k], |_| 1.0);
+    let mut n = simulate::clutter_plots(rng, [0.0, 6000.0, 0.0, 6000.0], &mut out[..k], |_| 1.0);
     for i in 0..5 {
         let (x, y) = cost_target(i, s);
-        if let Some((x, y)) = scene::detection(rng, 0.85, x, y, 5.0) {
+        if let Some((x, y)) = simulate::detection(rng, 0.85, x, y, 5.0) {
             if let Some(o) = out.get_mut(n) {
                 *o = Plot::new(9.0, x, y);
                 n += 1;
@@ -53,7 +53,7 @@ pub fn cost_scan(rng: &mut Rng, s: usize, out: &mut [Plot]) -> usize {
 }
 
 fn scan(rng: &mut Rng, s: usize, out: &mut [Plot; 48]) -> usize {
-    let n = scene::clutter_plots(rng, [0.0, 1500.0, 0.0, 1500.0], &mut out[..40], |_| 1.0);
+    let n = simulate::clutter_plots(rng, [0.0, 1500.0, 0.0, 1500.0], &mut out[..40], |_| 1.0);
     let t = s as f32;
     out[n] = Plot::new(5.0, 200.0 + 60.0 * t + 4.0 * rng.normal(), 300.0 + 40.0 * t);
     out[n + 1] = Plot::new(

@@ -133,7 +133,7 @@ pub fn cube(g: &CubeGeometry, k: usize, rng: &mut Rng, out: &mut [f32]) {
     }
     let mut order = [0u32; MAX_TARGETS * 27];
     let cells = cells.get_mut(..nc).unwrap_or(&mut []);
-    faint_core::scene::cube_returns(out, cells, &mut order, NOISE_VAR, rng);
+    faint_core::simulate::cube_returns(out, cells, &mut order, NOISE_VAR, rng);
 }
 
 /// One of Pei et al.'s three algorithms, as the golden cases and the firmware rows run it.

@@ -55,10 +55,10 @@ pub fn progress_bar(label: &str, n: usize) -> ProgressBar {
 pub const STACK_COPIES: usize = 8;
 
 /// The largest detector the host builds by value, in bytes: the second-order DP-TBD of
-/// the DP reproduction (`scenario::dp::Second25`, 6.3 MB); the PHD host filter is 3.1 MB.
+/// the DP reproduction (`simulate::dp::Second25`, 6.3 MB); the PHD host filter is 3.1 MB.
 /// A unit test checks this bound against `size_of` of every detector type the host builds
-/// by value. The larger DP detectors of `faint detect` (`scenario::dp::*At256`,
-/// `*At512`, up to 100 MB) are never built by value: `scenario::dp::boxed` zeroes and
+/// by value. The larger DP detectors of `faint detect` (`simulate::dp::*At256`,
+/// `*At512`, up to 100 MB) are never built by value: `simulate::dp::boxed` zeroes and
 /// configures them in place on the heap (tested on a 256 KiB stack).
 pub const LARGEST_DETECTOR: usize = 7 << 20;
 
@@ -163,15 +163,15 @@ mod tests {
         use faint_core::detect::pf_tbd::PfTbd;
         use std::mem::size_of;
         let sizes = [
-            size_of::<crate::reproduce::mht::Mht>(),
-            size_of::<crate::reproduce::mht::Classic>(),
-            size_of::<crate::scenario::phd::HostFilter>(),
-            size_of::<crate::scenario::cbmember::HostFilter>(),
-            size_of::<crate::scenario::cbmember::HostFilterComplex>(),
-            size_of::<crate::scenario::cbmember::HostFilterU8>(),
-            size_of::<crate::scenario::dp::Arnold25>(),
-            size_of::<crate::scenario::dp::Pulford25>(),
-            size_of::<crate::scenario::dp::Second25>(),
+            size_of::<crate::instances::mht::Mht>(),
+            size_of::<crate::instances::mht::Classic>(),
+            size_of::<crate::instances::phd::HostFilter>(),
+            size_of::<crate::instances::cbmember::HostFilter>(),
+            size_of::<crate::instances::cbmember::HostFilterComplex>(),
+            size_of::<crate::instances::cbmember::HostFilterU8>(),
+            size_of::<crate::simulate::dp::Arnold25>(),
+            size_of::<crate::simulate::dp::Pulford25>(),
+            size_of::<crate::simulate::dp::Second25>(),
             size_of::<crate::reliability::guided::Phd>(),
             size_of::<crate::reliability::guided::Cbm>(),
             size_of::<crate::reliability::guided::Second25>(),
@@ -206,7 +206,7 @@ mod tests {
         // The MHT-TBD of the reproduction is built on a worker, as `reproduce mht` does.
         let built = run_trials(5, 2, "mht", |_, _| {
             let cfg = faint_core::detect::mht::MhtConfig::sea_clutter();
-            crate::reproduce::mht::Mht::new(cfg).map(Box::new).is_ok()
+            crate::instances::mht::Mht::new(cfg).map(Box::new).is_ok()
         });
         assert_eq!(built, vec![true, true]);
     }

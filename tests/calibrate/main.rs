@@ -182,7 +182,7 @@ fn detect_uses_a_calibration_only_where_it_holds() {
         s(&cal),
         "--out",
         s(&o),
-        "--no-plots",
+        "--no-charts",
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("above the thresholds at Pfa 0.05"), "{out}");

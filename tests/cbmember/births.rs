@@ -6,7 +6,8 @@ use faint::core::detect::Detector;
 use faint::core::model::range_doppler::PointModel;
 use faint::core::rng::Rng;
 use faint::host::detect::{default_cbmember_file, normalise_frame, SpreadFrom};
-use faint::host::scenario::cbmember::{HostFilter, MapSource, RotorUav};
+use faint::host::instances::cbmember::HostFilter;
+use faint::host::simulate::cbmember::{MapSource, RotorUav};
 
 /// The default file with the model maps' own spread (the preset's `zeta_r = 3` m,
 /// `zeta_v = 5` m/s, with its 16-bin blocked likelihood): these tests run on maps drawn

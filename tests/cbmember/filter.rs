@@ -14,7 +14,8 @@ use faint::core::model::range_doppler::{
 };
 use faint::core::rng::Rng;
 use faint::core::{Complex32, Error};
-use faint::host::scenario::cbmember::{HostFilter, MapSource, RotorUav};
+use faint::host::instances::cbmember::HostFilter;
+use faint::host::simulate::cbmember::{MapSource, RotorUav};
 use faint_golden::cbmember::GOLDEN_WINDOW;
 use proptest::prelude::*;
 

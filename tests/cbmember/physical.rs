@@ -6,9 +6,9 @@ use faint::core::detect::Detector;
 use faint::core::model::range_doppler::{PointModel, RdSpread};
 use faint::core::rng::Rng;
 use faint::host::detect::{default_cbmember_file, normalise_frame};
+use faint::host::instances::cbmember::HostFilter;
 use faint::host::physics::cubes::Axis;
 use faint::host::physics::maps::{MapPhysics, Rotor};
-use faint::host::scenario::cbmember::HostFilter;
 
 /// Runs of 10 frames (a target at 20 dB peak-pixel SNR, random start and velocity over
 /// the map, with `blades` rotor blades of eq. 11 or none): how many runs' last frame

@@ -10,7 +10,7 @@ use faint::core::model::doppler::DopplerReport;
 use faint::core::rng::Rng;
 use faint::core::{Complex32, Error};
 use faint::host::reproduce::crpf::run_detector;
-use faint::host::scenario::crpf::{Noise, Othr, Run};
+use faint::host::simulate::crpf::{Noise, Othr, Run};
 
 use super::detectors::var_of;
 

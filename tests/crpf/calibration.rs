@@ -5,7 +5,7 @@ use faint::core::detect::crpf::CrpfConfig;
 use faint::core::rng::derive_seed;
 use faint::host::montecarlo::set_quiet;
 use faint::host::reproduce::crpf::{batch, METHODS};
-use faint::host::scenario::crpf::{Noise, Othr};
+use faint::host::simulate::crpf::{Noise, Othr};
 use faint::host::stats::detection::{detection_rate, threshold_at_pfa};
 
 #[test]

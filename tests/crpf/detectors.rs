@@ -11,7 +11,7 @@ use faint::core::rng::Rng;
 use faint::core::statistic::zeta_k;
 use faint::core::{Complex32, Error};
 use faint::host::reproduce::crpf::run_detector;
-use faint::host::scenario::crpf::{Noise, Othr, Run};
+use faint::host::simulate::crpf::{Noise, Othr, Run};
 
 const N: usize = 1000;
 

@@ -3,7 +3,7 @@
 use faint::core::model::doppler::*;
 use faint::core::rng::Rng;
 use faint::core::Complex32;
-use faint::host::scenario::crpf::{window, windowed_dft};
+use faint::host::simulate::crpf::{window, windowed_dft};
 
 /// Exact `h_b = A sum_n w_n exp(j 2 pi fd n ts) exp(-j 2 pi b n / m)` over all bins, f64.
 fn exact(fd: f64, amp: f64, m: usize, ts: f64) -> Vec<(f64, f64)> {

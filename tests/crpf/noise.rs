@@ -1,7 +1,7 @@
 //! The OTHR noise generators: complex Gaussian and complex generalized Gaussian (c = 0.1).
 
 use faint::core::rng::Rng;
-use faint::host::scenario::crpf::*;
+use faint::host::simulate::crpf::*;
 
 #[test]
 fn complex_gaussian_variance_and_kurtosis() {

@@ -4,7 +4,7 @@
 use faint::host::cli::grid;
 use faint::host::montecarlo::set_quiet;
 use faint::host::reproduce::crpf::{run, Args, METHODS};
-use faint::host::scenario::crpf::Noise;
+use faint::host::simulate::crpf::Noise;
 
 #[test]
 fn quick_reproduction_writes_every_output() {

@@ -8,7 +8,7 @@ use faint::core::detect::Detector;
 use faint::core::model::doppler::{unwindow, Likelihood, ModelConfig, Whitener, Window, MAX_BINS};
 use faint::core::rng::Rng;
 use faint::core::Complex32;
-use faint::host::scenario::crpf::{window_of, windowed_dft, Noise, Othr};
+use faint::host::simulate::crpf::{window_of, windowed_dft, Noise, Othr};
 
 fn samples(rng: &mut Rng, m: usize) -> Vec<(f64, f64)> {
     (0..m)

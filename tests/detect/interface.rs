@@ -11,9 +11,9 @@ use faint::core::detect::{run, Detector, ScoreKind};
 use faint::core::model::doppler::DopplerReport;
 use faint::core::rng::Rng;
 use faint::core::Complex32;
-use faint::host::reproduce::mht::Mht;
-use faint::host::scenario::crpf::{Noise, Othr};
-use faint::host::scenario::mht::SeaClutter;
+use faint::host::instances::mht::Mht;
+use faint::host::simulate::crpf::{Noise, Othr};
+use faint::host::simulate::mht::SeaClutter;
 
 fn check_doppler<D: Detector<Frame = [Complex32], Report = DopplerReport>>(
     det: &mut D,

@@ -12,12 +12,13 @@ use faint::core::detect::{run, Detector};
 use faint::core::model::doppler::{estimate_noise_variance, DopplerReport, ModelConfig};
 use faint::core::rng::Rng;
 use faint::host::detect::default_classic;
+use faint::host::instances::mht::{Classic, Mht};
+use faint::host::instances::phd::HostFilter;
 use faint::host::reproduce::crpf::run_detector;
-use faint::host::reproduce::mht::{Classic, Mht};
-use faint::host::scenario::crpf::{Noise, Othr};
-use faint::host::scenario::mht::SeaClutter;
-use faint::host::scenario::phd::Variant;
-use faint::host::scenario::phd::{HostFilter, SixTargets};
+use faint::host::simulate::crpf::{Noise, Othr};
+use faint::host::simulate::mht::SeaClutter;
+use faint::host::simulate::phd::SixTargets;
+use faint::host::simulate::phd::Variant;
 
 use super::{faint, s, temp};
 
@@ -84,7 +85,7 @@ fn detect_with(
         &seed,
         "--min-score",
         "-1e30",
-        "--no-plots",
+        "--no-charts",
     ];
     if let Some(c) = config {
         args.extend(["--config", s(c)]);
@@ -262,7 +263,7 @@ fn doppler_detectors_are_scale_free() {
             &seed,
             "--min-score",
             "0.5",
-            "--no-plots",
+            "--no-charts",
         ];
         if let Some(c) = cfg {
             args.extend(["--config", s(c)]);
@@ -419,7 +420,7 @@ fn printed_config_is_the_default() {
             &DET_SEED.to_string(),
             "--min-score",
             "-1e30",
-            "--no-plots",
+            "--no-charts",
         ]);
         assert_eq!(code, 0, "{err}");
         assert_eq!(read_rows(&dir.join("b/detections.csv")), a, "{name}");
@@ -492,7 +493,7 @@ fn truth_numbered_from_one() {
         ];
         let o = dir.join(out);
         args.push(s(&o));
-        args.push("--no-plots");
+        args.push("--no-charts");
         args.extend_from_slice(extra);
         let (code, _, err) = faint(&args);
         (code, err, std::fs::read_to_string(o.join("gospa.csv")).ok())
@@ -525,7 +526,8 @@ fn truth_numbered_from_one() {
 fn cbmember_detectors_round_trip() {
     use faint::core::detect::cbmember::CbmemberConfig;
     use faint::core::model::range_doppler::PointModel;
-    use faint::host::scenario::cbmember::{HostFilter as Cbm, MapSource, RotorUav};
+    use faint::host::instances::cbmember::HostFilter as Cbm;
+    use faint::host::simulate::cbmember::{MapSource, RotorUav};
     let dir = temp("rt-cbm");
     let file = dir.join("maps.npy");
     let (code, _, err) = faint(&[

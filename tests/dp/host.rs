@@ -9,7 +9,7 @@ use faint::core::detect::{run, Detector};
 use faint::core::rng::Rng;
 use faint::host::io::output::write_real_frames;
 use faint::host::reproduce::dp::{trace, Variant};
-use faint::host::scenario::dp::{
+use faint::host::simulate::dp::{
     boxed, pad_image, Arnold25, Arnold25At256, Arnold9, Arnold9At256, DimPoint, Pulford9,
     Pulford9At256, Second25, Second25At512, Second9, Second9At256,
 };
@@ -81,7 +81,7 @@ fn detect(name: &str, input: &Path, out: &Path, truth: &Path) -> Vec<(usize, u32
         s(out),
         "--truth",
         s(truth),
-        "--no-plots",
+        "--no-charts",
     ]);
     assert_eq!(code, 0, "{name}: {err}");
     assert!(stdout.contains("mean GOSPA"), "{stdout}");
@@ -299,7 +299,7 @@ fn ends(name: &str, input: &Path, out: &Path) -> Vec<(usize, String, String)> {
         s(input),
         "--out",
         s(out),
-        "--no-plots",
+        "--no-charts",
     ]);
     assert_eq!(code, 0, "{name}: {err}");
     let mut r = csv::Reader::from_path(out.join("detections.csv")).unwrap();

@@ -4,7 +4,7 @@ use faint::host::montecarlo::set_quiet;
 use faint::host::reproduce::mht::{
     calibrate, false_track_counts, pilot_floor, proportion_ci, CalibRule, FalseTrackCounts,
 };
-use faint::host::scenario::mht::SeaClutter;
+use faint::host::simulate::mht::SeaClutter;
 
 fn counts(periods: u64, floor: u8, with_track: &[u64]) -> FalseTrackCounts {
     FalseTrackCounts {

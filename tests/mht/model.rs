@@ -8,7 +8,7 @@ use faint::host::analysis::mht::{
     CellModel, ChainSource, CompoundModel, ModelParams,
 };
 use faint::host::reproduce::mht::{detectors, evaluate_trial, model_params};
-use faint::host::scenario::mht::SeaClutter;
+use faint::host::simulate::mht::SeaClutter;
 
 #[test]
 fn run_value_examples() {

@@ -4,7 +4,7 @@
 use faint::core::detect::Detector;
 use faint::core::rng::Rng;
 use faint::host::reproduce::mht::{attribute, detectors, stage3_fates, Fate};
-use faint::host::scenario::mht::SeaClutter;
+use faint::host::simulate::mht::SeaClutter;
 
 /// The instrumented stage 3 confirms exactly the detector's tracks (peak, line, plots),
 /// at two densities and thresholds where peaks are short, merged and residual-rejected.

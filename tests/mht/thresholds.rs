@@ -9,8 +9,8 @@ use faint::core::detect::Detector;
 use faint::core::model::plot::Plot;
 use faint::core::rng::Rng;
 use faint::host::detect::{clutter_density, mht_gamma};
-use faint::host::reproduce::mht::Mht;
-use faint::host::scenario::mht::SeaClutter;
+use faint::host::instances::mht::Mht;
+use faint::host::simulate::mht::SeaClutter;
 
 use crate::common::{faint_quiet, temp};
 
@@ -36,7 +36,7 @@ fn mht_gamma_holds_its_rate_on_fresh_clutter() {
         m.configure(&at, 0).unwrap();
         let mut tracks = 0;
         for _ in 0..cfg.n_scans {
-            let k = faint::host::scenario::mht::poisson(&mut rng, sc.lambda);
+            let k = faint::host::simulate::mht::poisson(&mut rng, sc.lambda);
             let plots: Vec<Plot> = (0..k)
                 .map(|_| Plot::new(1.0, rng.uniform_range(x0, x1), rng.uniform_range(y0, y1)))
                 .collect();
@@ -86,7 +86,7 @@ fn thresholds_follow_the_measured_density() {
         clean.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
-        "--no-plots",
+        "--no-charts",
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(stdout.contains("gamma_1 = "), "{stdout}");
@@ -113,7 +113,7 @@ fn thresholds_follow_the_measured_density() {
         dense.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
-        "--no-plots",
+        "--no-charts",
     ]);
     assert_eq!(code, 0, "{err}");
     let warnings: Vec<&str> = err.lines().filter(|l| l.starts_with("warning:")).collect();

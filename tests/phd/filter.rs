@@ -5,7 +5,8 @@ use faint::core::detect::phd::{PsoConfig, SmcPhdTbd};
 use faint::core::detect::Detector;
 use faint::core::rng::Rng;
 use faint::core::Error;
-use faint::host::scenario::phd::{HostFilter, SixTargets, Variant};
+use faint::host::instances::phd::HostFilter;
+use faint::host::simulate::phd::{SixTargets, Variant};
 use faint::host::stats::ospa::ospa;
 
 /// The host filter is ~5 MB of fixed arrays: run on a thread with a big stack.

@@ -16,10 +16,11 @@ use faint::core::model::doppler::{check_frame, estimate_noise_variance};
 use faint::core::model::plot::Plot;
 use faint::core::rng::Rng;
 use faint::core::{Complex32, Error};
+use faint::host::instances::mht::Mht;
+use faint::host::instances::phd::HostFilter;
 use faint::host::reliability::check_outputs;
 use faint::host::reliability::targets::small_phd;
-use faint::host::reproduce::mht::Mht;
-use faint::host::scenario::phd::{HostFilter, Variant};
+use faint::host::simulate::phd::Variant;
 
 /// Runs `f` on a thread with a 256 MB stack (the host filters are large values).
 fn big_stack<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {

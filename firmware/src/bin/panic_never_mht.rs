@@ -38,7 +38,7 @@ use faint_core::detect::mht::{
 use faint_core::detect::{Detector, Validate};
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
-use faint_core::scene;
+use faint_core::simulate;
 use faint_firmware::semihosting::finish;
 use faint_firmware::statics::only_ref;
 
@@ -143,7 +143,7 @@ fn make_scan(
     let Some(out) = buf.get_mut(..n) else {
         return 0;
     };
-    let mut n = scene::clutter_plots(rng, area, out, |r| 1.0 + r.uniform());
+    let mut n = simulate::clutter_plots(rng, area, out, |r| 1.0 + r.uniform());
     if kind == Kind::Empty || kind == Kind::Overflow {
         return n;
     }
@@ -161,7 +161,7 @@ fn make_scan(
         (area[0] + 0.5 * w, area[3] - 0.1 * h - 0.02 * h * t),
     ];
     for (x, y) in targets {
-        if let Some((x, y)) = scene::detection(rng, 0.9, x, y, 0.002 * w) {
+        if let Some((x, y)) = simulate::detection(rng, 0.9, x, y, 0.002 * w) {
             if let Some(p) = buf.get_mut(n) {
                 *p = Plot::new(5.0, x, y);
                 n += 1;

@@ -242,7 +242,7 @@ pub fn simulate(
             let scans: Vec<Vec<Plot>> = (0..frames)
                 .map(|k| {
                     let mut rng = Rng::from_stream(seed, k as u64);
-                    let n = crate::scenario::mht::poisson(&mut rng, plots_per_scan as f32);
+                    let n = crate::simulate::mht::poisson(&mut rng, plots_per_scan as f32);
                     (0..n)
                         .map(|_| {
                             let a = pool[rng.below(pool.len() as u32) as usize];

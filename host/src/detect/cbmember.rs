@@ -22,8 +22,8 @@ use serde::{Deserialize, Serialize};
 
 use super::phd::normalise;
 use super::{drive, find_default, json, load, NoiseLevel, Outcome, Request};
+use crate::instances::cbmember::HostFilter as CbmemberHost;
 use crate::io::input::read_real_frames;
-use crate::scenario::cbmember::HostFilter as CbmemberHost;
 use crate::timing::thread_cpu_seconds as cpu;
 
 /// Scale-dependent values of the CBMeMBer configuration in dB over the noise power.

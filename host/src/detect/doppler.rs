@@ -19,7 +19,7 @@ use crate::timing::thread_cpu_seconds as cpu;
 
 /// Particle counts the particle-filter detectors are built for (the capacity is a
 /// compile-time constant of the core).
-pub const PARTICLES: [usize; 4] = [1000, 2000, 4000, 6000];
+pub use crate::instances::doppler::DETECT_PARTICLES as PARTICLES;
 
 /// A Doppler-frame detector's configuration file (CRPF-TBD: `C = CrpfConfig`; the
 /// Gaussian comparators: `C = GaussConfig`).

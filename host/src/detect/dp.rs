@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{drive_with, find_default, json, load, Outcome, Request, XY_POSITION};
 use crate::io::input::read_real_frames;
-use crate::scenario::dp::{capacity, pad_image, with_dp_sized, CAPACITIES};
+use crate::simulate::dp::{capacity, pad_image, with_dp_sized, CAPACITIES};
 use crate::stats::noise::{median, MAD_TO_STD};
 use crate::timing::thread_cpu_seconds as cpu;
 

@@ -45,7 +45,7 @@ pub use cbmember::{
 };
 pub use doppler::{bin_variance, DopplerFile, GaussFile, PARTICLES};
 pub use dp::{robust_noise, DpFile, DpNoise, DpSettings};
-pub use output::{check_input, read_truth, write, write_plots, Selection, Written};
+pub use output::{check_input, read_truth, write, write_charts, Selection, Written};
 pub use phd::{default_phd_file, normalise_frame, PhdFile, PhdSnr};
 pub use plots::{
     classic_threshold, clutter_density, default_classic, mht_gamma, PlotFile, DEFAULT_GRID_PFA,

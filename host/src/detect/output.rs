@@ -7,7 +7,7 @@ use anyhow::{anyhow, bail, ensure, Context, Result};
 use serde::Serialize;
 
 use super::{InputView, Outcome};
-use crate::io::plot::{heatmap, line_chart, scatter, Cell, Series};
+use crate::io::chart::{heatmap, line_chart, scatter, Cell, Series};
 use crate::io::{write_csv, write_json, write_text};
 use crate::stats::gospa::{gospa_with, Gospa};
 
@@ -161,7 +161,7 @@ struct GospaRow {
 /// (`detections.csv`, `detections.json`), every frame's reported count and best score, the
 /// written count and, with a calibration, the frame's threshold and Pfa (`summary.csv`), the reports if collected (`reports.json`) and, with a
 /// truth, the per-frame GOSPA (`gospa.csv`; cut-off `c`, order 2, alpha = 2) between the
-/// truth and the written detections' positions. The plots are [`write_plots`].
+/// truth and the written detections' positions. The charts are [`write_charts`].
 pub fn write(
     out: &Outcome,
     dir: &Path,
@@ -299,11 +299,11 @@ pub fn write(
     })
 }
 
-/// Draws the plots of a written outcome into `dir`: `score.svg` (best score per frame)
+/// Draws the charts of a written outcome into `dir`: `score.svg` (best score per frame)
 /// and `tracks.svg` (the detections `select` keeps, over the input).
 /// Long inputs are drawn in blocks of frames (at most 400 columns) and with at most
 /// 20 000 background plots, so the files stay small.
-pub fn write_plots(out: &Outcome, dir: &Path, select: Selection) -> Result<()> {
+pub fn write_charts(out: &Outcome, dir: &Path, select: Selection) -> Result<()> {
     let kept: Vec<&super::Row> = out.rows.iter().filter(|r| select.keeps(r)).collect();
     let mut best = vec![None::<f32>; out.frames];
     for r in &out.rows {
@@ -337,8 +337,7 @@ pub fn write_plots(out: &Outcome, dir: &Path, select: Selection) -> Result<()> {
             }],
         )?;
     }
-    tracks_plot(out, &kept, &dir.join("tracks.svg"))?;
-    tracks_plot(out, &kept, &dir.join("tracks.svg"))
+    tracks_chart(out, &kept, &dir.join("tracks.svg"))
 }
 
 /// Columns of the Doppler map in `tracks.svg`.
@@ -348,7 +347,7 @@ const MAX_POINTS: usize = 20_000;
 
 /// The estimated tracks over the input: Doppler estimates over the frames' bin powers,
 /// Hough tracks over every plot, PHD estimates in x/y.
-fn tracks_plot(out: &Outcome, kept: &[&super::Row], path: &Path) -> Result<()> {
+fn tracks_chart(out: &Outcome, kept: &[&super::Row], path: &Path) -> Result<()> {
     let title = format!("{}: detections over the input", out.detector);
     match &out.view {
         InputView::Doppler { frames, bin_hz } => {

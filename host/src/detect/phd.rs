@@ -15,9 +15,10 @@ use serde::{Deserialize, Serialize};
 use faint_core::detect::{Detector, Validate};
 
 use super::{drive, find_default, json, load, NoiseLevel, Outcome, Request};
+use crate::instances::phd::HostFilter;
 use crate::io::input::{read_real_frames, Frames};
-pub(super) use crate::scenario::phd::Variant;
-use crate::scenario::phd::{HostFilter, SixTargets};
+use crate::simulate::phd::SixTargets;
+pub(super) use crate::simulate::phd::Variant;
 use crate::stats::noise::{exponential_mean, median};
 use crate::timing::thread_cpu_seconds as cpu;
 

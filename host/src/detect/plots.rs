@@ -9,10 +9,10 @@ use faint_core::model::plot::Plot;
 use serde::{Deserialize, Serialize};
 
 use super::{drive, find_default, json, load, valid, InputView, Outcome, Request, XY_POSITION};
-use crate::analysis::mht::classic_gamma;
+use crate::analysis::mht::{classic_gamma, max_count};
+use crate::instances::mht::{Classic, Mht, ANGLE_CELLS, RANGE_CELLS, SCANS};
 use crate::io::input::read_plots;
-use crate::reproduce::mht::{max_count, Classic, Mht, NR, NT};
-use crate::scenario::mht::SeaClutter;
+use crate::simulate::mht::SeaClutter;
 use crate::stats::noise::median;
 use crate::timing::thread_cpu_seconds as cpu;
 
@@ -84,7 +84,7 @@ pub fn mht_gamma(config: &MhtConfig, lambda: f64, pfa: f64, seed: u64) -> Result
             m.configure(&step_cfg, 0).map_err(|e| anyhow!("{e}"))?;
             let mut with = vec![false; n + 2];
             for _ in 0..n {
-                let k = crate::scenario::mht::poisson(rng, lambda as f32);
+                let k = crate::simulate::mht::poisson(rng, lambda as f32);
                 let plots: Vec<Plot> = (0..k)
                     .map(|_| Plot::new(1.0, rng.uniform_range(x0, x1), rng.uniform_range(y0, y1)))
                     .collect();
@@ -119,7 +119,7 @@ pub fn mht_gamma(config: &MhtConfig, lambda: f64, pfa: f64, seed: u64) -> Result
 pub fn classic_threshold(config: &ClassicHoughConfig, lambda: f64, pfa: f64) -> usize {
     let [x0, x1, y0, y1] = config.area.map(f64::from);
     let side = ((x1 - x0) * (y1 - y0)).sqrt();
-    classic_gamma(side, NR, NT, config.n_scans, lambda, pfa)
+    classic_gamma(side, RANGE_CELLS, ANGLE_CELLS, config.n_scans, lambda, pfa)
 }
 
 fn check_grid_pfa(p: Option<f64>) -> Result<()> {
@@ -139,8 +139,8 @@ pub fn default_classic() -> ClassicHoughConfig {
     let sc = SeaClutter::paper(80.0);
     let gamma = crate::analysis::mht::classic_gamma(
         f64::from(sc.area[1] - sc.area[0]),
-        crate::reproduce::mht::NR,
-        crate::reproduce::mht::NT,
+        RANGE_CELLS,
+        ANGLE_CELLS,
         sc.n_scans,
         f64::from(sc.lambda),
         1e-4,
@@ -158,9 +158,9 @@ pub(super) fn run_mht(req: &Request) -> Result<Outcome> {
         check_grid_pfa(f.gamma_grid_pfa)?;
         valid(&f.config)?;
         ensure!(
-            f.config.n_scans <= crate::reproduce::mht::NS,
+            f.config.n_scans <= SCANS,
             "invalid configuration value: n_scans (at most {} here)",
-            crate::reproduce::mht::NS
+            SCANS
         );
         Ok(())
     })?;

@@ -1,4 +1,4 @@
-//! Output: CSV and JSON files, Markdown tables, and SVG plots ([`plot`]); recorded
+//! Output: CSV and JSON files, Markdown tables, and SVG charts ([`chart`]); recorded
 //! frames and plot lists read from `.npy`/`.npz`/CSV ([`input`]) and written in the same
 //! formats ([`output`]).
 //!
@@ -10,9 +10,9 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use serde::Serialize;
 
+pub mod chart;
 pub mod input;
 pub mod output;
-pub mod plot;
 
 fn ensure_parent(path: &Path) -> Result<()> {
     if let Some(dir) = path.parent() {

@@ -58,8 +58,8 @@ use serde_value::Value as Tree;
 use super::frames::{self, complex, len_or_short, plots, reals, Mode, BAD, EXTREMES};
 use super::mutate::{FLOATS, INTS};
 use super::{check_outputs, outputs, twin_check, Kind};
-use crate::reproduce::mht::{Classic, Mht, P as MHT_PLOTS};
-use crate::scenario::phd::{SixTargets, Variant};
+use crate::instances::mht::{Classic, Mht, PLOTS as MHT_PLOTS};
+use crate::simulate::phd::{SixTargets, Variant};
 
 /// What one input did (for the fuzz targets' statistics and the replay tests).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]

@@ -30,10 +30,11 @@ use super::frames::{self, complex, len_or_short, plots, reals, Mode};
 use super::soak::{soak, Shape, Soak, WorkCounters};
 use super::{fuzz, Options, Tally, Target};
 use crate::detect::default_classic;
-use crate::reproduce::mht::{Classic, Mht, P as MHT_PLOTS};
-use crate::scenario::cbmember::HostFilter as CbmemberHost;
-use crate::scenario::dp::{self as sdp, SIDE};
-use crate::scenario::phd::{HostFilter as PhdHost, SixTargets, Variant};
+use crate::instances::cbmember::HostFilter as CbmemberHost;
+use crate::instances::mht::{Classic, Mht, PLOTS as MHT_PLOTS};
+use crate::instances::phd::HostFilter as PhdHost;
+use crate::simulate::dp::{self as sdp, SIDE};
+use crate::simulate::phd::{SixTargets, Variant};
 
 /// Particles of the particle-filter detectors in a campaign (the smallest host size).
 pub const PARTICLES: usize = 1000;
@@ -133,7 +134,7 @@ type Second32 = SecondOrderDp<
     { second_order_words(REDUCED_SIDE, 9, sdp::HISTORY) },
 >;
 
-// SAFETY: the same types as `scenario::dp`'s (integers, floats, bools, fieldless enums
+// SAFETY: the same types as `simulate::dp`'s (integers, floats, bools, fieldless enums
 // whose first variant is 0), on a smaller image: their `unconfigured()` is all zeros.
 unsafe impl sdp::ZeroValid for Arnold32 {}
 // SAFETY: as above.

@@ -201,6 +201,20 @@ impl ModelParams {
     }
 }
 
+/// The largest binary-integration count of an accumulator's cells: the statistic whose
+/// whole-grid law the models give (a period is a false alarm when it reaches `gamma`).
+pub fn max_count<const R: usize, const A: usize>(
+    acc: &faint_core::detect::mht::Accumulator<R, A>,
+) -> u8 {
+    let mut m = 0;
+    for a in 0..A {
+        for r in 0..R {
+            m = m.max(acc.count(r, a));
+        }
+    }
+    m
+}
+
 /// Length of the line `x cos(th) + y sin(th) = rho` inside the square `[-h, h]^2`.
 pub fn chord(rho: f64, th: f64, h: f64) -> f64 {
     let (c, s) = (th.cos(), th.sin());

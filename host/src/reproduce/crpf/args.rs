@@ -5,10 +5,10 @@ use std::path::PathBuf;
 
 use anyhow::{ensure, Result};
 
-use super::evaluation::{ComparatorModel, Likelihood, VarSource};
+use super::comparators::{ComparatorModel, Likelihood, VarSource};
 use crate::cli;
-use crate::scenario::crpf::{Noise, Othr};
 use crate::shard::ShardArg;
+use crate::simulate::crpf::{Noise, Othr};
 use faint_core::detect::pf_tbd::BirthProposal;
 use faint_core::model::doppler::{Phase, Window};
 use serde::{Deserialize, Serialize};
@@ -280,7 +280,7 @@ impl Settings {
 }
 
 /// Particle counts `faint reproduce crpf` is compiled for (see [`run_stats`](super::run_stats)).
-pub const PARTICLES: [usize; 7] = [100, 250, 500, 1000, 2000, 4000, 6000];
+pub use crate::instances::doppler::REPRODUCE_PARTICLES as PARTICLES;
 
 /// `--birth-proposal`: `exact` or `fixed-share:<s>`, `s` finite in (0, 1) (the particle
 /// count then gives `B = round(s N)`, clamped to `1..=N-1`).

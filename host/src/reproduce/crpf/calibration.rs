@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use super::args::Settings;
 use super::evaluation::{Stats, METHODS};
-use crate::scenario::crpf::Noise;
+use crate::simulate::crpf::Noise;
 use crate::stats::detection::{detection_rate, threshold_at_pfa, Proportion, Threshold};
 
 /// Calibration check of one statistic (`calibration.csv`).

@@ -8,15 +8,17 @@
 //! rate of the threshold set on the other half (calibration). The Gaussian comparators
 //! use the per-bin noise variance estimated from the run's K frames.
 //!
-//! The code is split by role: [`Args`] and its checks in `args.rs`, the thresholds and
-//! their calibration check in `calibration.rs`, the detectors' statistics, Pd versus SNR
-//! and the sweeps in `evaluation.rs`, and the CSV, SVG and Markdown outputs in
-//! `figures.rs`; [`run`] chains them.
+//! The code is split by role: [`Args`] and its checks in `args.rs`, the comparators'
+//! noise model in `comparators.rs`, the thresholds and their calibration check in
+//! `calibration.rs`, the detectors' statistics, Pd versus SNR and the sweeps in
+//! `evaluation.rs`, and the CSV, SVG and Markdown outputs in `outputs.rs`; [`run`] chains
+//! them.
 
 mod args;
 mod calibration;
+mod comparators;
 mod evaluation;
-mod figures;
+mod outputs;
 
 use std::path::Path;
 
@@ -24,16 +26,14 @@ use anyhow::Result;
 use faint_core::detect::crpf::CrpfConfig;
 use faint_core::rng::derive_seed;
 
-use crate::scenario::crpf::{Noise, Othr};
 use crate::shard::{self, Batch, Merged, Run, Shard};
+use crate::simulate::crpf::{Noise, Othr};
 use args::Settings;
 
 pub use args::{Args, EchoPhase, PhaseModel, SceneWindow, PARTICLES};
 pub use calibration::calibration;
-pub use evaluation::{
-    batch, batch_range, run_detector, run_stats, ComparatorModel, Comparators, Likelihood, Stats,
-    VarSource, METHODS,
-};
+pub use comparators::{ComparatorModel, Comparators, Likelihood, VarSource};
+pub use evaluation::{batch, batch_range, run_detector, run_stats, Stats, METHODS};
 
 /// One Monte Carlo batch of the reproduction: its key in shard files, its runs and how
 /// they are drawn.
@@ -146,15 +146,15 @@ fn analyse(a: &Settings, mut runs: Vec<Vec<Stats>>, seconds: impl Fn() -> f64) -
 
     // H0: thresholds and calibration.
     let th = calibration::thresholds(a, &h0)?;
-    figures::h0(&dir, a, &h0, &th)?;
+    outputs::h0(&dir, a, &h0, &th)?;
 
     // H1: Pd versus SNR.
     let pd = evaluation::pd_vs_snr(a, &a.grid, &h1, &th.values)?;
-    figures::pd_vs_snr(&dir, a, &pd)?;
+    outputs::pd_vs_snr(&dir, a, &pd)?;
 
     // Table: SNR at Pd = 0.5 and 0.9.
     let snr_rows = evaluation::snr_at_pd_rows(a, &pd.curves);
-    let md = figures::table(&dir, a, &snr_rows, &th, &pd.fd_err, seconds())?;
+    let md = outputs::table(&dir, a, &snr_rows, &th, &pd.fd_err, seconds())?;
 
     if a.sweeps {
         let mut pairs = Vec::new();
@@ -163,7 +163,7 @@ fn analyse(a: &Settings, mut runs: Vec<Vec<Stats>>, seconds: impl Fn() -> f64) -
             pairs.push((h0, h1));
         }
         let sw = evaluation::sweeps(a, &cfg, &pairs)?;
-        figures::sweeps(a, &sw)?;
+        outputs::sweeps(a, &sw)?;
     }
     println!("{md}");
     println!("written to {}", dir.display());

@@ -7,7 +7,7 @@ use faint_core::detect::dp::{DpConfig, DpTrack, Method, Transition};
 use faint_core::rng::Rng;
 use serde::Serialize;
 
-use crate::scenario::dp::{qb_for, with_dp, DimPoint, Run, Truth, HISTORY, METHODS};
+use crate::simulate::dp::{qb_for, with_dp, DimPoint, Run, Truth, HISTORY, METHODS};
 
 /// What one detector showed on one target run, frame by frame (index `n - 1` after `n`
 /// frames).

@@ -18,7 +18,7 @@ use serde::Serialize;
 
 use crate::analysis::dp::montecarlo::{self, NOISE_SIDE, TARGET_SIDE};
 use crate::analysis::dp::{analyse, Setup};
-use crate::io::{self, plot::Series};
+use crate::io::{self, chart::Series};
 
 /// What Fig. 5 runs.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -153,8 +153,8 @@ pub fn run(opts: &Fig5Options, out: &Path) -> Result<String> {
     }
     io::write_csv(out.join("fig5.csv"), &rows)?;
     let title = format!("Fig. 5: P_D vs frames, SNR {}, P_FA {}", opts.snr, opts.pfa);
-    io::plot::line_chart(out.join("fig5.svg"), &title, "frames n", "P_D", &pd_series)?;
-    io::plot::line_chart_log_y(
+    io::chart::line_chart(out.join("fig5.svg"), &title, "frames n", "P_D", &pd_series)?;
+    io::chart::line_chart_log_y(
         out.join("fig5_pfa.svg"),
         "Fig. 5: noise-track P_FA at the analytic V_T",
         "frames n",

@@ -29,9 +29,9 @@ use serde::Serialize;
 
 use crate::analysis::dp::track_thresholds;
 use crate::cli;
-use crate::io::{self, plot::Series};
+use crate::io::{self, chart::Series};
 use crate::montecarlo::run_trials;
-use crate::scenario::dp::{DimPoint, HISTORY, METHODS};
+use crate::simulate::dp::{DimPoint, HISTORY, METHODS};
 use crate::stats::detection::{proportion, threshold_at_pfa, Proportion};
 
 pub mod eval;
@@ -476,7 +476,7 @@ fn plot_level(d: &std::path::Path, pts: &[Point], level: Level, speed: u8) -> Re
     let l = level.name();
     let s6 = series(|p| p.frames_mean);
     if s6.iter().any(|s| !s.points.is_empty()) {
-        io::plot::line_chart(
+        io::chart::line_chart(
             d.join(format!("fig6_{l}_{speed}px.svg")),
             &format!("Fig. 6: frames to detect, {l} level, {speed} px/frame"),
             "SNR (a / sigma)",
@@ -486,7 +486,7 @@ fn plot_level(d: &std::path::Path, pts: &[Point], level: Level, speed: u8) -> Re
     }
     let s7 = series(|p| p.err_mean);
     if s7.iter().any(|s| !s.points.is_empty()) {
-        io::plot::line_chart(
+        io::chart::line_chart(
             d.join(format!("fig7_{l}_{speed}px.svg")),
             &format!("Fig. 7: errT at the last frame, {l} level, {speed} px/frame"),
             "SNR (a / sigma)",

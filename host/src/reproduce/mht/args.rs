@@ -4,10 +4,8 @@
 
 use std::path::PathBuf;
 
-#[cfg(doc)]
-use super::calibration::calibrate;
-use super::calibration::proportion_ci;
 use crate::cli;
+use crate::stats::detection::proportion;
 
 /// Command-line arguments.
 #[derive(clap::Args, Debug, Clone)]
@@ -46,7 +44,7 @@ pub struct Args {
     pub model: ModelChoice,
     /// Where `gamma_1` comes from: `model` (the `--model` law's grid Pfa) or `sim`
     /// (clutter-only simulation: the smallest `gamma_1` whose rate of periods with a
-    /// confirmed track meets `--pfa` by `--calib-rule`, see [`calibrate`]).
+    /// confirmed track meets `--pfa` by `--calib-rule`, see [`calibrate`](super::calibrate)).
     #[arg(long, value_enum, default_value_t = GammaFrom::Model)]
     pub gamma_from: GammaFrom,
     /// Clutter-only periods per lambda for `--gamma-from sim`, 1 to 1000000
@@ -73,7 +71,7 @@ pub enum GammaFrom {
     /// The `--model` law.
     #[default]
     Model,
-    /// Clutter-only simulation of the confirmed-false-track rate ([`calibrate`]).
+    /// Clutter-only simulation of the confirmed-false-track rate ([`calibrate`](super::calibrate)).
     Sim,
 }
 
@@ -93,7 +91,7 @@ impl CalibRule {
     pub fn passes(self, k: u64, n: u64, pfa: f64) -> bool {
         match self {
             Self::Point => (k as f64) <= pfa * n as f64,
-            Self::Upper => proportion_ci(k, n).2 <= pfa,
+            Self::Upper => proportion(k as usize, n as usize).hi <= pfa,
         }
     }
 }

@@ -8,9 +8,12 @@ use faint_core::detect::mht::MhtTbd;
 use faint_core::detect::Detector;
 
 use super::args::{Args, CalibRule, GammaFrom, ModelChoice, Sizes};
-use super::evaluation::{detectors, max_count, NR, NT};
-use crate::analysis::mht::{self as model, CellModel, ChainSource, CompoundModel, ModelParams};
-use crate::scenario::mht::SeaClutter;
+use super::detectors::detectors;
+use crate::analysis::mht::{
+    self as model, max_count, CellModel, ChainSource, CompoundModel, ModelParams,
+};
+use crate::instances::mht::{ANGLE_CELLS, RANGE_CELLS};
+use crate::simulate::mht::SeaClutter;
 
 /// Clutter-only false-track counts per candidate `gamma_1` (index = `gamma_1`).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -173,8 +176,8 @@ pub fn thresholds_with(sc: &SeaClutter, pfa: f64, choice: ModelChoice) -> (usize
     let g1 = GridModel::new(mp, choice).gamma_for_pfa(pfa);
     let gc = model::classic_gamma(
         f64::from(sc.area[1] - sc.area[0]),
-        NR,
-        NT,
+        RANGE_CELLS,
+        ANGLE_CELLS,
         sc.n_scans,
         f64::from(sc.lambda),
         pfa,
@@ -191,8 +194,8 @@ pub fn model_params(sc: &SeaClutter) -> ModelParams {
         pd0: f64::from(sc.pd0),
         n_targets: sc.n_targets,
         gate_cells: f64::from(sc.v_max * sc.t_scan / sc.resolution),
-        n_rho: NR,
-        n_theta: NT,
+        n_rho: RANGE_CELLS,
+        n_theta: ANGLE_CELLS,
         lambda: f64::from(sc.lambda),
     }
 }

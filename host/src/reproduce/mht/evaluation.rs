@@ -1,37 +1,19 @@
-//! Monte Carlo evaluation of `faint reproduce mht`: the detectors' capacities and types
-//! ([`Mht`], [`Classic`]), one trial of both detectors scored by the rules of the module
-//! doc ([`evaluate_trial`]), the scoring and clutter-only trials of one lambda, and their
-//! per-lambda summary against the models.
+//! Monte Carlo evaluation of `faint reproduce mht`: one trial of both detectors scored
+//! by the rules of the module doc ([`evaluate_trial`]), the scoring and clutter-only
+//! trials of one lambda, and their per-lambda summary against the models.
 
-use faint_core::detect::mht::{
-    ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, Track, NO_PLOT,
-};
+use faint_core::detect::mht::{Track, NO_PLOT};
 use faint_core::detect::Detector;
 
 use super::args::{Args, Sizes};
 use super::calibration::{model_params, proportion_ci, Gammas, GridModel};
-use crate::analysis::mht::{self as model, CellModel, ChainSource, CompoundModel};
-use crate::scenario::mht::{Origin, SeaClutter, Trial};
+use super::detectors::detectors;
+use crate::analysis::mht::{self as model, max_count, CellModel, ChainSource, CompoundModel};
+use crate::instances::mht::{Classic, Mht, SCANS};
+use crate::simulate::mht::{Origin, SeaClutter, Trial};
 
-/// Plots per scan capacity (Poisson(398) exceeds 520 with probability ~1e-9).
-pub const P: usize = 640;
-/// Scans per period capacity.
-pub const NS: usize = 30;
-/// `N_rho`.
-pub const NR: usize = 256;
-/// `N_theta`.
-pub const NT: usize = 180;
-/// Track capacity.
-pub const TR: usize = 32;
-/// The MHT-TBD detector of the reproduction.
-pub type Mht = MhtTbd<P, NS, NR, NT, TR>;
-/// The classic detector of the reproduction.
-pub type Classic = ClassicHough<NR, NT, 64>;
 /// Line-to-truth tolerance (m).
 pub const MATCH_TOL: f32 = 60.0;
-
-/// Re-exported for tests: the geometry type of the reproduction.
-pub type Grid = Geometry<NR, NT>;
 
 /// Everything measured in one trial.
 #[derive(Debug, Clone, Copy, Default, serde::Serialize)]
@@ -80,7 +62,7 @@ fn line_matches(theta: f32, c: f32, trial: &Trial, i: usize, t_scan: f32) -> boo
 }
 
 /// Plots of `track` made by target `i`.
-pub fn target_plots_in(track: &Track<NS>, trial: &Trial, i: usize) -> usize {
+pub fn target_plots_in(track: &Track<SCANS>, trial: &Trial, i: usize) -> usize {
     (0..trial.scans.len())
         .filter(|&s| {
             track.plots[s] != NO_PLOT
@@ -93,26 +75,13 @@ pub fn target_plots_in(track: &Track<NS>, trial: &Trial, i: usize) -> usize {
 /// The targets a confirmed track matches (scoring rule of the module doc: the line within
 /// `MATCH_TOL` of all the target's noise-free positions, or more than half of the track's
 /// plots the target's).
-pub fn track_targets(track: &Track<NS>, trial: &Trial, t_scan: f32) -> Vec<usize> {
+pub fn track_targets(track: &Track<SCANS>, trial: &Trial, t_scan: f32) -> Vec<usize> {
     (0..trial.targets.len())
         .filter(|&i| {
             line_matches(track.theta, track.c, trial, i, t_scan)
                 || 2 * target_plots_in(track, trial, i) > usize::from(track.n_plots)
         })
         .collect()
-}
-
-/// The largest binary-integration count of the accumulator's cells.
-pub fn max_count<const R: usize, const A: usize>(
-    acc: &faint_core::detect::mht::Accumulator<R, A>,
-) -> u8 {
-    let mut m = 0;
-    for a in 0..A {
-        for r in 0..R {
-            m = m.max(acc.count(r, a));
-        }
-    }
-    m
 }
 
 /// Run both detectors on one trial and score them.
@@ -216,28 +185,6 @@ pub fn evaluate_trial(
     }
     st.classic_detected = cmatched.iter().filter(|&&m| m).count() as u32;
     st
-}
-
-/// Build the two detectors for a lambda and its thresholds.
-pub fn detectors(
-    sc: &SeaClutter,
-    gamma1: u8,
-    gamma_classic: u8,
-) -> anyhow::Result<(Box<Mht>, Box<Classic>)> {
-    let mut cfg = MhtConfig::sea_clutter();
-    cfg.area = sc.area;
-    cfg.n_scans = sc.n_scans;
-    cfg.gate = sc.v_max * sc.t_scan;
-    cfg.along_gate = cfg.gate;
-    cfg.gamma1 = gamma1;
-    let mht = Box::new(Mht::new(cfg).map_err(|e| anyhow::anyhow!("{e}"))?);
-    let ccfg = ClassicHoughConfig {
-        area: sc.area,
-        n_scans: sc.n_scans,
-        gamma: gamma_classic,
-    };
-    let classic = Box::new(Classic::new(ccfg).map_err(|e| anyhow::anyhow!("{e}"))?);
-    Ok((mht, classic))
 }
 
 /// The scoring trials (`sizes.trials`, targets on) and the clutter-only trials

@@ -19,27 +19,27 @@
 //!   whose largest count reaches `gamma`, next to the model's eq. 28.
 //!
 //! The code is split by role: [`Args`] and its checks in `args.rs`, the thresholds (the
-//! models' and the simulation's calibration of `gamma_1`) in `calibration.rs`, the trials
-//! and their scoring in `evaluation.rs`, and the CSV, SVG and Markdown outputs in
-//! `figures.rs`; [`run`] chains them.
+//! models' and the simulation's calibration of `gamma_1`) in `calibration.rs`, the two
+//! detectors built for a scene in `detectors.rs`, the trials and their scoring in
+//! `evaluation.rs`, and the CSV, SVG and Markdown outputs in `outputs.rs`; [`run`] chains
+//! them.
 
 mod args;
 mod calibration;
+mod detectors;
 mod evaluation;
-mod figures;
+mod outputs;
 mod stages;
 
-use crate::scenario::mht::SeaClutter;
+use crate::simulate::mht::SeaClutter;
 
 pub use args::{Args, CalibRule, GammaFrom, ModelChoice};
 pub use calibration::{
     calibrate, false_track_counts, model_params, pilot_floor, proportion_ci, thresholds,
     thresholds_with, FalseTrackCounts, GridModel, PILOT_PERIODS,
 };
-pub use evaluation::{
-    detectors, evaluate_trial, max_count, target_plots_in, track_targets, Classic, Grid, Mht,
-    TrialStats, MATCH_TOL, NR, NS, NT, P, TR,
-};
+pub use detectors::detectors;
+pub use evaluation::{evaluate_trial, target_plots_in, track_targets, TrialStats, MATCH_TOL};
 pub use stages::{attribute, stage3_fates, Fate, Loss, StageReport};
 
 /// Entry point.
@@ -47,14 +47,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let sizes = args.validate()?;
     let mut calib_csv = Vec::new();
     crate::cli::out_dir(&args.out)?;
-    let model_md = figures::model_figures(&args.out)?;
+    let model_md = outputs::model_figures(&args.out)?;
     let mut summaries = Vec::new();
     let mut null_rows = Vec::new();
     for (li, &lambda) in args.lambda.iter().enumerate() {
         let sc = SeaClutter::paper(lambda);
         let th = calibration::gammas(args, &sizes, li, &sc, &mut calib_csv);
         let (res, nres) = evaluation::trials(args, &sizes, li, &sc, &th)?;
-        figures::trials_csv(&args.out, lambda, &res)?;
+        outputs::trials_csv(&args.out, lambda, &res)?;
         summaries.push(evaluation::summarise(
             args,
             &sizes,
@@ -65,9 +65,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             &mut null_rows,
         ));
     }
-    figures::tables(&args.out, &summaries, &null_rows, &calib_csv)?;
-    figures::monte_carlo_figures(args, &summaries, &null_rows)?;
-    let md = figures::summary_md(args, &sizes, &summaries, &model_md)?;
+    outputs::tables(&args.out, &summaries, &null_rows, &calib_csv)?;
+    outputs::monte_carlo_figures(args, &summaries, &null_rows)?;
+    let md = outputs::summary_md(args, &sizes, &summaries, &model_md)?;
     println!("{md}");
     Ok(())
 }

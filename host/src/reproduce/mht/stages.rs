@@ -27,8 +27,10 @@ use faint_core::detect::Detector;
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
 
-use super::evaluation::{detectors, target_plots_in, track_targets, Mht, NR, NS, NT, P, TR};
-use crate::scenario::mht::{Origin, SeaClutter, Trial};
+use super::detectors::detectors;
+use super::evaluation::{target_plots_in, track_targets};
+use crate::instances::mht::{Mht, ANGLE_CELLS, PLOTS, RANGE_CELLS, SCANS, TRACKS};
+use crate::simulate::mht::{Origin, SeaClutter, Trial};
 
 /// What stage 3 did with one peak (peaks are taken strongest first).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -57,16 +59,16 @@ impl Fate {
 
 /// Stage 3 of `m`'s completed period at `gamma1`: every peak's recovered track and fate.
 /// The confirmed ones equal `m.tracks()` when `gamma1` is `m`'s `gamma_1`.
-pub fn stage3_fates(m: &Mht, gamma1: u8) -> Vec<(Track<NS>, Fate)> {
+pub fn stage3_fates(m: &Mht, gamma1: u8) -> Vec<(Track<SCANS>, Fate)> {
     let cfg = *m.config();
-    let ns = cfg.n_scans.min(NS);
+    let ns = cfg.n_scans.min(SCANS);
     let mut acc = Box::new(m.accumulator().clone());
-    let mut peaks = [Peak::default(); TR];
-    let n_peaks = usize::from(acc.condense(gamma1, &mut peaks).peaks).min(TR);
+    let mut peaks = [Peak::default(); TRACKS];
+    let n_peaks = usize::from(acc.condense(gamma1, &mut peaks).peaks).min(TRACKS);
     let scans: Vec<&[Plot]> = (0..ns).map(|s| m.scan_plots(s)).collect();
-    let flags: Vec<[u8; P]> = (0..ns)
+    let flags: Vec<[u8; PLOTS]> = (0..ns)
         .map(|s| {
-            let mut f = [0u8; P];
+            let mut f = [0u8; PLOTS];
             for (k, fk) in f.iter_mut().enumerate().take(scans[s].len()) {
                 if m.is_effective(s, k) {
                     *fk = FLAG_EFFECTIVE;
@@ -81,11 +83,13 @@ pub fn stage3_fates(m: &Mht, gamma1: u8) -> Vec<(Track<NS>, Fate)> {
         lookback: cfg.lookback,
     };
     let geom = m.dmht_geometry();
-    let mut confirmed: Vec<Track<NS>> = Vec::new();
+    let mut confirmed: Vec<Track<SCANS>> = Vec::new();
     let mut out = Vec::with_capacity(n_peaks);
     for pk in &peaks[..n_peaks] {
-        let mut tr = Track::<NS>::default();
-        dmht::recover::<NR, NT, P, NS>(geom, *pk, &scans, &flags, &assoc, &mut tr);
+        let mut tr = Track::<SCANS>::default();
+        dmht::recover::<RANGE_CELLS, ANGLE_CELLS, PLOTS, SCANS>(
+            geom, *pk, &scans, &flags, &assoc, &mut tr,
+        );
         let shared = |s: usize| {
             tr.plots[s] != NO_PLOT && confirmed.iter().any(|o| o.plots[s] == tr.plots[s])
         };
@@ -220,8 +224,8 @@ fn cell_scans(
 fn best_cell(m: &Mht, trial: &Trial, ns: usize, i: usize) -> (usize, usize) {
     let g = m.dmht_geometry();
     let mut best = (0usize, 0u8, 0usize, 0usize);
-    let mut seen = vec![0u32; NR];
-    for a in 0..NT {
+    let mut seen = vec![0u32; RANGE_CELLS];
+    for a in 0..ANGLE_CELLS {
         seen.fill(0);
         for s in 0..ns {
             for (k, p) in m.scan_plots(s).iter().enumerate() {
@@ -247,13 +251,13 @@ fn best_cell(m: &Mht, trial: &Trial, ns: usize, i: usize) -> (usize, usize) {
 impl StageReport {
     /// Add one completed period of `m` (configured with `gamma1`) on `trial`.
     pub fn add(&mut self, m: &Mht, trial: &Trial, t_scan: f32, gamma1: u8) {
-        let ns = m.config().n_scans.min(NS);
+        let ns = m.config().n_scans.min(SCANS);
         let fates = stage3_fates(m, gamma1);
         self.trials += 1;
         for (_, f) in &fates {
             self.peak_fates[f.index()] += 1;
         }
-        let confirmed: Vec<&Track<NS>> = fates
+        let confirmed: Vec<&Track<SCANS>> = fates
             .iter()
             .filter(|(_, f)| *f == Fate::Confirmed)
             .map(|(t, _)| t)

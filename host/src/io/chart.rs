@@ -1,4 +1,4 @@
-//! SVG plots with `plotters` (SVG needs no font files, so it works on any machine).
+//! SVG charts with `plotters` (SVG needs no font files, so it works on any machine).
 
 use std::path::Path;
 

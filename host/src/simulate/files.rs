@@ -27,11 +27,11 @@ use serde::Serialize;
 use crate::cli;
 use crate::io::output::{write_complex_frames, write_plots, write_real_frames};
 use crate::io::write_csv;
-use crate::scenario::cbmember::{MapSource, RotorUav};
-use crate::scenario::crpf::{Noise, Othr};
-use crate::scenario::dp::{qb_for, DimPoint};
-use crate::scenario::mht::SeaClutter;
-use crate::scenario::phd::SixTargets;
+use crate::simulate::cbmember::{MapSource, RotorUav};
+use crate::simulate::crpf::{Noise, Othr};
+use crate::simulate::dp::{qb_for, DimPoint};
+use crate::simulate::mht::SeaClutter;
+use crate::simulate::phd::SixTargets;
 
 /// What to simulate.
 #[derive(Debug, Clone)]

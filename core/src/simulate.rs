@@ -1,4 +1,4 @@
-//! Scene synthesis without allocation, shared by the host's simulators, the golden cases
+//! Simulation of scenes without allocation, shared by the host's simulators, the golden cases
 //! and the firmware's measured scenes, so that all three draw the same numbers in the same
 //! order: clutter plots, noisy detections of a target, and a target's returns in a power
 //! cube.

@@ -11,7 +11,7 @@
 
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
-use faint_core::scene;
+use faint_core::simulate;
 
 /// Who made a plot.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -96,11 +96,11 @@ impl SeaClutter {
             let nc = poisson(rng, self.lambda);
             let mut items: Vec<(Plot, Origin)> = Vec::with_capacity(nc + self.n_targets);
             let mut clutter = vec![Plot::new(0.0, 0.0, 0.0); nc];
-            scene::clutter_plots(rng, self.area, &mut clutter, |r| 1.0 + r.exponential());
+            simulate::clutter_plots(rng, self.area, &mut clutter, |r| 1.0 + r.exponential());
             items.extend(clutter.into_iter().map(|p| (p, Origin::Clutter)));
             for (i, t) in targets.iter().enumerate() {
                 let (x, y) = t.position(s as f32 * self.t_scan);
-                if let Some((x, y)) = scene::detection(rng, self.pd0, x, y, self.sigma) {
+                if let Some((x, y)) = simulate::detection(rng, self.pd0, x, y, self.sigma) {
                     let x = x.clamp(self.area[0], self.area[1]);
                     let y = y.clamp(self.area[2], self.area[3]);
                     let a = 1.0 + 8.0 * rng.exponential();

@@ -135,7 +135,7 @@ pub fn boxed<D: DpTrack + ZeroValid>(cfg: &DpConfig) -> Result<Box<D>> {
 macro_rules! with_dp {
     ($method:expr, $qb:expr, $cfg:expr, |$det:ident| $body:expr) => {{
         use faint_core::detect::dp::Method as M_;
-        use $crate::scenario::dp as sdp;
+        use $crate::simulate::dp as sdp;
         match ($method, $qb) {
             (M_::Arnold, 9) => {
                 let $det = sdp::boxed::<sdp::Arnold9>($cfg)?;
@@ -173,7 +173,7 @@ pub(crate) use with_dp;
 macro_rules! with_dp_sized {
     ($method:expr, $qb:expr, $side:expr, $cfg:expr, |$det:ident| $body:expr) => {{
         use faint_core::detect::dp::Method as M_;
-        use $crate::scenario::dp as sdp;
+        use $crate::simulate::dp as sdp;
         match ($method, $qb, $side) {
             (M_::Arnold, 9, 128) => {
                 let $det = sdp::boxed::<sdp::Arnold9>($cfg)?;

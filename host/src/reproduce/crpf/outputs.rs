@@ -9,8 +9,8 @@ use anyhow::Result;
 use super::args::Settings;
 use super::calibration::Thresholds;
 use super::evaluation::{PdCurves, SnrRow, Stats, Sweeps, METHODS};
-use crate::io::{self, plot};
-use crate::scenario::crpf::Noise;
+use crate::io::{self, chart};
+use crate::simulate::crpf::Noise;
 
 /// H0 outputs: `h0_stats.csv`, `calibration.csv` and Fig. 1 (H0 histograms of the
 /// existence statistics).
@@ -19,7 +19,7 @@ pub(super) fn h0(dir: &Path, a: &Settings, h0: &[Stats], th: &Thresholds) -> Res
     io::write_csv(dir.join("calibration.csv"), &th.rows)?;
     // Fig. 1: H0 histograms of zeta_K and D_K.
     let col = |f: fn(&Stats) -> f64| h0.iter().map(f).collect::<Vec<f64>>();
-    plot::histogram(
+    chart::histogram(
         dir.join("fig1_h0_statistics.svg"),
         &format!("H0 existence statistics, N = {}, K = 32", a.particles),
         "statistic",
@@ -39,10 +39,10 @@ pub(super) fn h0(dir: &Path, a: &Settings, h0: &[Stats], th: &Thresholds) -> Res
 /// `pd_vs_snr.csv` and the Pd versus SNR figure (Fig. 2 for Gaussian noise, else Fig. 4).
 pub(super) fn pd_vs_snr(dir: &Path, a: &Settings, pd: &PdCurves) -> Result<()> {
     io::write_csv(dir.join("pd_vs_snr.csv"), &pd.rows)?;
-    let series: Vec<plot::Series> = METHODS
+    let series: Vec<chart::Series> = METHODS
         .iter()
         .zip(&pd.curves)
-        .map(|(n, c)| plot::Series {
+        .map(|(n, c)| chart::Series {
             name: n.to_string(),
             points: c.iter().map(|p| (p.snr_db, p.pd.p)).collect(),
         })
@@ -52,7 +52,7 @@ pub(super) fn pd_vs_snr(dir: &Path, a: &Settings, pd: &PdCurves) -> Result<()> {
     } else {
         "fig4"
     };
-    plot::line_chart(
+    chart::line_chart(
         dir.join(format!("{fig}_pd_vs_snr.svg")),
         &format!(
             "Pd vs SNR, {:?} noise, N = {}, Pfa = {}",
@@ -152,7 +152,7 @@ pub(super) fn sweeps(a: &Settings, sw: &Sweeps) -> Result<()> {
     let names = ["CRPF-max", "CRPF-mean"];
     let pfa = sw.pfa;
     for (k, (param, xl)) in [("r_th", "r_th"), ("lambda", "lambda")].iter().enumerate() {
-        plot::line_chart(
+        chart::line_chart(
             dir.join(format!("fig5_{param}.svg")),
             &format!(
                 "Pd at 5 dB vs {param} (Gaussian, N = {}, Pfa = {pfa})",
@@ -161,7 +161,7 @@ pub(super) fn sweeps(a: &Settings, sw: &Sweeps) -> Result<()> {
             xl,
             "Pd",
             &(0..2)
-                .map(|mi| plot::Series {
+                .map(|mi| chart::Series {
                     name: names[mi].into(),
                     points: sw.series[2 * k + mi].clone(),
                 })

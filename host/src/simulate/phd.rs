@@ -293,7 +293,7 @@ impl SixTargets {
                 .for_each_cell(&g, &c, |idx, h| cells.push((idx, a * h)));
         }
         let mut order = vec![0u32; cells.len()];
-        faint_core::scene::cube_returns(cube, &mut cells, &mut order, s2, rng);
+        faint_core::simulate::cube_returns(cube, &mut cells, &mut order, s2, rng);
     }
 
     /// Filter configuration for `variant`.
@@ -354,9 +354,6 @@ impl SixTargets {
         }
     }
 }
-
-/// Capacities used on the host for this preset: particles, swarm entries, points, targets.
-pub type HostFilter = faint_core::detect::phd::SmcPhdTbd<8192, 16384, 10, 16>;
 
 /// Which of Pei et al.'s three algorithms a configuration of the preset runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

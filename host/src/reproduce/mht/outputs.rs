@@ -8,7 +8,7 @@ use super::args::{Args, GammaFrom, Sizes};
 use super::calibration::{proportion_ci, CalibRow};
 use super::evaluation::{NullRow, Summary, TrialStats};
 use crate::analysis::mht::{CellModel, ModelParams};
-use crate::io::plot::{self, Series};
+use crate::io::chart::{self, Series};
 use crate::io::write_csv;
 
 /// A chart of `(name, points)` series, on a logarithmic y axis if `log_y`; nothing is
@@ -33,9 +33,9 @@ fn line_chart(
         })
         .collect();
     if log_y {
-        plot::line_chart_log_y(path, title, xl, yl, &series)
+        chart::line_chart_log_y(path, title, xl, yl, &series)
     } else {
-        plot::line_chart(path, title, xl, yl, &series)
+        chart::line_chart(path, title, xl, yl, &series)
     }
 }
 

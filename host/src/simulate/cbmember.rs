@@ -41,7 +41,7 @@
 
 use std::sync::Arc;
 
-use faint_core::detect::cbmember::{gain_for_snr, CbmemberConfig, CbmemberTbd};
+use faint_core::detect::cbmember::{gain_for_snr, CbmemberConfig};
 use faint_core::model::range_doppler::{
     point_velocities, simulate_power, LitTarget, PointModel, RdGeometry, RdSpread, KAPPA,
     MAX_POINTS,
@@ -50,13 +50,6 @@ use faint_core::rng::Rng;
 use faint_core::Complex32;
 use rustfft::{Fft, FftPlanner};
 use serde::Serialize;
-
-/// The host filter: 4 components of up to 1500 particles, 256 x 32 block sums, power maps.
-pub type HostFilter = CbmemberTbd<4, 1500, 8192, [f32]>;
-/// The same on complex maps.
-pub type HostFilterComplex = CbmemberTbd<4, 1500, 8192, [Complex32]>;
-/// The same on quantised `u8` maps.
-pub type HostFilterU8 = CbmemberTbd<4, 1500, 8192, [u8]>;
 
 /// Map generator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]

@@ -1,15 +1,22 @@
-//! Scenario presets, one module per detector family, named like the family (the preset
-//! keeps the scene's name on the CLI): [`crpf`] holds `othr`, [`mht`] `sea-clutter`,
-//! [`phd`] `six-targets`, [`cbmember`] `rotor-uav`, [`dp`] `dim-point`. A preset is data: a struct holding the paper's values and the
-//! documented choices for what the paper leaves open.
+//! Simulation: every scene the host simulates, one module per detector family, and
+//! `faint simulate`, which writes a scene's frames and truth as files (`files.rs`).
+//!
+//! A scene is a preset named like its paper's scene on the CLI: [`crpf`] holds `othr`,
+//! [`mht`] `sea-clutter`, [`phd`] `six-targets`, [`cbmember`] `rotor-uav`, [`dp`]
+//! `dim-point`. A preset is data: a struct holding the paper's values and the documented
+//! choices for what the paper leaves open. The allocation-free pieces the firmware and the
+//! golden cases share are in `faint_core::simulate`.
 
 use anyhow::{bail, Result};
 
 pub mod cbmember;
 pub mod crpf;
 pub mod dp;
+mod files;
 pub mod mht;
 pub mod phd;
+
+pub use files::{check, simulate, truth_path, Simulated, Spec};
 
 /// `(name, one-line description, preset as JSON)` of every built-in scenario.
 type Entry = (&'static str, &'static str, fn() -> serde_json::Value);
