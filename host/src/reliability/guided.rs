@@ -56,6 +56,9 @@ use super::frames::{self, complex, len_or_short, plots, reals, Mode, BAD, EXTREM
 use super::mutate::{FLOATS, INTS};
 use super::{check_outputs, outputs, twin_check, Kind};
 use crate::reproduce::mht::{Classic, Mht, P as MHT_PLOTS};
+use crate::scenario::dp::fuzz::{
+    Arnold25, Arnold9, Pulford25, Pulford9, Second25, Second9, SIDE as DP_SIDE,
+};
 use crate::scenario::phd::{SixTargets, Variant};
 
 /// What one input did (for the fuzz targets' statistics and the replay tests).
@@ -524,10 +527,6 @@ pub const PHD_CUBE: [usize; 3] = [10, 10, 8];
 pub type Cbm = CbmemberTbd<4, 128, 512, [f32]>;
 /// CBMeMBer map: range x velocity bins over the preset's extent.
 pub const CBM_MAP: [usize; 2] = [32, 64];
-
-use crate::scenario::dp::fuzz::{
-    Arnold25, Arnold9, Pulford25, Pulford9, Second25, Second9, SIDE as DP_SIDE,
-};
 
 /// Largest frame a generator draws (a configuration asking for more gets short frames).
 const MAX_FRAME: usize = 1 << 16;
