@@ -10,21 +10,19 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use faint::core::detect::dp::{
-    arnold_words, pulford_words, second_order_words, ArnoldDp, DpConfig, DpTrack, Method,
-    PulfordDp, SecondOrderDp,
-};
+use faint::core::detect::dp::{DpConfig, DpTrack, Method};
+use faint::core::dp_tbd;
 use faint::core::rng::Rng;
 
 const M: usize = 128;
 const L: usize = 8;
 const SIGMA: f32 = 1.5;
 
-type A9 = ArnoldDp<M, 9, L, { arnold_words(M, 9, L) }>;
-type A25 = ArnoldDp<M, 25, L, { arnold_words(M, 25, L) }>;
-type P9 = PulfordDp<M, 9, L, { pulford_words(M, 9, L) }>;
-type S9 = SecondOrderDp<M, 9, L, { second_order_words(M, 9, L) }>;
-type S9i8 = SecondOrderDp<M, 9, L, { second_order_words(M, 9, L) }, i8>;
+type A9 = dp_tbd!(Arnold, M, 9, L);
+type A25 = dp_tbd!(Arnold, M, 25, L);
+type P9 = dp_tbd!(Pulford, M, 9, L);
+type S9 = dp_tbd!(SecondOrder, M, 9, L);
+type S9i8 = dp_tbd!(SecondOrder, M, 9, L, i8);
 
 /// 16 frames: noise plus `2 sigma` in the pixel of a target moving at (0.8, 0.5) px/frame.
 fn frames() -> Vec<Vec<f32>> {
@@ -62,14 +60,14 @@ fn bench_one<D: DpTrack>(c: &mut Criterion, name: &str, mut det: Box<D>, cfg: Dp
 fn bench_dp(c: &mut Criterion) {
     let arnold = DpConfig::dim_point(Method::Arnold, 1);
     let second = DpConfig::dim_point(Method::SecondOrder, 1);
-    bench_one(c, "arnold_3x3", Box::new(A9::unconfigured()), arnold);
-    bench_one(c, "arnold_5x5", Box::new(A25::unconfigured()), arnold);
+    bench_one(c, "arnold_3x3", Box::new(A9::new_unconfigured()), arnold);
+    bench_one(c, "arnold_5x5", Box::new(A25::new_unconfigured()), arnold);
     let pulford = DpConfig::dim_point(Method::Pulford, 1);
-    bench_one(c, "pulford_3x3", Box::new(P9::unconfigured()), pulford);
+    bench_one(c, "pulford_3x3", Box::new(P9::new_unconfigured()), pulford);
     bench_one(
         c,
         "second_order_3x3_i16",
-        Box::new(S9::unconfigured()),
+        Box::new(S9::new_unconfigured()),
         second,
     );
     let coarse = DpConfig {
@@ -79,7 +77,7 @@ fn bench_dp(c: &mut Criterion) {
     bench_one(
         c,
         "second_order_3x3_i8",
-        Box::new(S9i8::unconfigured()),
+        Box::new(S9i8::new_unconfigured()),
         coarse,
     );
 }

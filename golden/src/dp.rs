@@ -8,11 +8,9 @@
 //! [`frame`] is also the firmware's scene (at 128 x 128 and 64 x 64).
 
 use crate::{Fold, ERR, SEED};
-use faint_core::detect::dp::{
-    arnold_words, pulford_words, second_order_words, ArnoldDp, DpConfig, DpTrack, Method,
-    PulfordDp, SecondOrderDp,
-};
+use faint_core::detect::dp::{DpConfig, DpTrack, Method};
 use faint_core::detect::Detector;
+use faint_core::dp_tbd;
 use faint_core::rng::Rng;
 
 /// Noise standard deviation of the scene.
@@ -113,48 +111,48 @@ pub(crate) fn cases(emit: &mut dyn FnMut(&str, &[u32])) {
     let s = DpConfig::dim_point(Method::SecondOrder, 1);
     emit_run(
         "dp.arnold9",
-        &mut ArnoldDp::<M, 9, L, { arnold_words(M, 9, L) }>::unconfigured(),
+        &mut <dp_tbd!(Arnold, M, 9, L)>::new_unconfigured(),
         &a,
         emit,
     );
     emit_run(
         "dp.arnold9_i8",
-        &mut ArnoldDp::<M, 9, L, { arnold_words(M, 9, L) }, i8>::unconfigured(),
+        &mut <dp_tbd!(Arnold, M, 9, L, i8)>::new_unconfigured(),
         &a,
         emit,
     );
     emit_run(
         "dp.arnold25",
-        &mut ArnoldDp::<M, 25, L, { arnold_words(M, 25, L) }>::unconfigured(),
+        &mut <dp_tbd!(Arnold, M, 25, L)>::new_unconfigured(),
         &a,
         emit,
     );
     emit_run(
         "dp.pulford9",
-        &mut PulfordDp::<M, 9, L, { pulford_words(M, 9, L) }>::unconfigured(),
+        &mut <dp_tbd!(Pulford, M, 9, L)>::new_unconfigured(),
         &p,
         emit,
     );
     emit_run(
         "dp.second9",
-        &mut SecondOrderDp::<M, 9, L, { second_order_words(M, 9, L) }>::unconfigured(),
+        &mut <dp_tbd!(SecondOrder, M, 9, L)>::new_unconfigured(),
         &s,
         emit,
     );
     emit_run(
         "dp.second9_i8",
-        &mut SecondOrderDp::<M, 9, L, { second_order_words(M, 9, L) }, i8>::unconfigured(),
+        &mut <dp_tbd!(SecondOrder, M, 9, L, i8)>::new_unconfigured(),
         &s,
         emit,
     );
     emit_run(
         "dp.second25",
-        &mut SecondOrderDp::<M, 25, L, { second_order_words(M, 25, L) }>::unconfigured(),
+        &mut <dp_tbd!(SecondOrder, M, 25, L)>::new_unconfigured(),
         &s,
         emit,
     );
     // Huge finite values: clamped, finite merits.
-    let mut det = SecondOrderDp::<M, 9, L, { second_order_words(M, 9, L) }>::unconfigured();
+    let mut det = <dp_tbd!(SecondOrder, M, 9, L)>::new_unconfigured();
     let mut words = [ERR; 3];
     if det.configure(&s, 0).is_ok() {
         let mut z = [0f32; M * M];

@@ -174,7 +174,7 @@ mod tests {
             size_of::<crate::simulate::dp::Second25>(),
             size_of::<crate::reliability::guided::Phd>(),
             size_of::<crate::reliability::guided::Cbm>(),
-            size_of::<crate::reliability::guided::Second25>(),
+            size_of::<crate::simulate::dp::fuzz::Second25>(),
             size_of::<CrpfTbd<6000>>(),
             size_of::<PfTbd<6000>>(),
             size_of::<BernoulliTbd<6000>>(),

@@ -2,9 +2,8 @@
 //! independent population simulation of the same independence model, its exact cases
 //! (n <= 2) against the detectors, and the analysis figure's ordering.
 
-use faint_core::detect::dp::{
-    arnold_words, second_order_words, transition_table, ArnoldDp, DpConfig, Method, SecondOrderDp,
-};
+use faint_core::detect::dp::{transition_table, DpConfig, Method};
+use faint_core::dp_tbd;
 use faint_core::rng::Rng;
 use faint_host::analysis::dp::{analyse, montecarlo, track_thresholds, Setup};
 
@@ -155,17 +154,19 @@ fn the_laws_match_a_population_simulation_of_the_independence_model() {
 /// n = 2 (correlation ~0.16), so the tolerance is 4 binomial standard errors doubled.
 #[test]
 fn the_detectors_match_the_exact_cases() {
-    type A = ArnoldDp<256, 9, 2, { arnold_words(256, 9, 2) }>;
-    type S = SecondOrderDp<256, 9, 3, { second_order_words(256, 9, 3) }>;
+    type A = dp_tbd!(Arnold, 256, 9, 2);
+    type S = dp_tbd!(SecondOrder, 256, 9, 3);
     for method in [Method::Arnold, Method::SecondOrder] {
         let cfg = DpConfig::dim_point(method, 1);
         let c = analyse(&cfg, &setup(method, 9), 2, PFA, None).unwrap();
         let vt: Vec<f32> = c.threshold.iter().map(|&v| v as f32).collect();
         let mc = match method {
             Method::Arnold => {
-                montecarlo::noise_check(|| Box::new(A::unconfigured()), &cfg, 1, &vt, PFA, 8, 5)
+                montecarlo::noise_check(|| Box::new(A::new_unconfigured()), &cfg, 1, &vt, PFA, 8, 5)
             }
-            _ => montecarlo::noise_check(|| Box::new(S::unconfigured()), &cfg, 1, &vt, PFA, 8, 5),
+            _ => {
+                montecarlo::noise_check(|| Box::new(S::new_unconfigured()), &cfg, 1, &vt, PFA, 8, 5)
+            }
         }
         .unwrap();
         for (k, (point, &p)) in mc.iter().zip(&c.pfa).enumerate() {

@@ -8,6 +8,7 @@ use faint::core::detect::dp::{
     DpConfig, DpReport, DpTrack, Method, PulfordDp, SecondOrderDp, Transition,
 };
 use faint::core::detect::{run, Detector};
+use faint::core::dp_tbd;
 use faint::core::rng::Rng;
 use faint::core::Error;
 use proptest::prelude::*;
@@ -15,11 +16,11 @@ use proptest::prelude::*;
 const M: usize = 6;
 const LSB: f32 = 0.0625;
 
-type A9 = ArnoldDp<M, 9, 4, { arnold_words(M, 9, 4) }>;
-type A25 = ArnoldDp<M, 25, 4, { arnold_words(M, 25, 4) }>;
-type S9 = SecondOrderDp<M, 9, 4, { second_order_words(M, 9, 4) }>;
-type S25 = SecondOrderDp<M, 25, 4, { second_order_words(M, 25, 4) }>;
-type P9 = PulfordDp<M, 9, 4, { pulford_words(M, 9, 4) }>;
+type A9 = dp_tbd!(Arnold, M, 9, 4);
+type A25 = dp_tbd!(Arnold, M, 25, 4);
+type S9 = dp_tbd!(SecondOrder, M, 9, 4);
+type S25 = dp_tbd!(SecondOrder, M, 25, 4);
+type P9 = dp_tbd!(Pulford, M, 9, 4);
 
 fn cfg(method: Method) -> DpConfig {
     DpConfig::dim_point(method, 1)
@@ -163,12 +164,10 @@ fn first_order_equals_exhaustive_search_on_wider_frames() {
     const W: usize = 16;
     for seed in 0..3 {
         let fr = frames(50 + seed, 4, W);
-        let mut a =
-            ArnoldDp::<W, 9, 4, { arnold_words(W, 9, 4) }>::new(cfg(Method::Arnold)).unwrap();
+        let mut a = <dp_tbd!(Arnold, W, 9, 4)>::new(cfg(Method::Arnold)).unwrap();
         run_all(&mut a, &fr);
         assert_eq!(merits(&a), brute_first(&fr, W, 1), "3x3 seed {seed}");
-        let mut b =
-            ArnoldDp::<W, 25, 4, { arnold_words(W, 25, 4) }>::new(cfg(Method::Arnold)).unwrap();
+        let mut b = <dp_tbd!(Arnold, W, 25, 4)>::new(cfg(Method::Arnold)).unwrap();
         run_all(&mut b, &fr);
         assert_eq!(merits(&b), brute_first(&fr, W, 2), "5x5 seed {seed}");
         for i in 0..W * W {
@@ -355,17 +354,16 @@ fn bad_configs_are_typed_errors() {
     );
     // window larger than the image
     assert_eq!(
-        ArnoldDp::<4, 25, 2, { arnold_words(4, 25, 2) }>::new(a).err(),
+        <dp_tbd!(Arnold, 4, 25, 2)>::new(a).err(),
         Some(Error::InvalidConfig("window larger than the image"))
     );
     assert_eq!(
-        SecondOrderDp::<2, 9, 2, { second_order_words(2, 9, 2) }>::new(cfg(Method::SecondOrder))
-            .err(),
+        <dp_tbd!(SecondOrder, 2, 9, 2)>::new(cfg(Method::SecondOrder)).err(),
         Some(Error::InvalidConfig("window larger than the image"))
     );
     // not a square window
     assert_eq!(
-        ArnoldDp::<M, 10, 2, { arnold_words(M, 10, 2) }>::new(a).err(),
+        <dp_tbd!(Arnold, M, 10, 2)>::new(a).err(),
         Some(Error::InvalidConfig("q_b"))
     );
     // bad values, named
@@ -404,15 +402,15 @@ fn bad_configs_are_typed_errors() {
 fn unconfigured_detectors_refuse_to_step() {
     let z = vec![0.0f32; M * M];
     assert_eq!(
-        A9::unconfigured().step(&z),
+        A9::new_unconfigured().step(&z),
         Err(Error::InvalidConfig("unconfigured"))
     );
     assert_eq!(
-        S9::unconfigured().step(&z),
+        S9::new_unconfigured().step(&z),
         Err(Error::InvalidConfig("unconfigured"))
     );
     assert_eq!(
-        P9::unconfigured().step(&z),
+        P9::new_unconfigured().step(&z),
         Err(Error::InvalidConfig("unconfigured"))
     );
 }
@@ -420,7 +418,7 @@ fn unconfigured_detectors_refuse_to_step() {
 /// `configure` on a zeroed (const) value equals `new`, and `reset` restarts exactly.
 #[test]
 fn zeroed_statics_and_reset_equal_a_new_detector() {
-    static mut S: S9 = S9::unconfigured();
+    static mut S: S9 = S9::new_unconfigured();
     let c = cfg(Method::SecondOrder);
     let fr = frames(11, 6, M);
     let mut fresh = S9::new(c).unwrap();
@@ -492,7 +490,7 @@ fn detections_are_the_distinct_best_ends() {
 /// a bright target converges to the target's velocity.
 #[test]
 fn pulford_follows_a_bright_target() {
-    type P = PulfordDp<24, 9, 12, { pulford_words(24, 9, 12) }>;
+    type P = dp_tbd!(Pulford, 24, 9, 12);
     let mut d = P::new(cfg(Method::Pulford)).unwrap();
     let mut rng = Rng::seed_from_u64(4);
     for k in 0..12 {
@@ -685,7 +683,7 @@ fn static_ram_equals_the_formulas() {
 fn first_clamped_finds_the_pixels_the_quantiser_clamps() {
     let c = cfg(Method::Arnold);
     let lim = 16384.0 * c.lsb;
-    let mut d = A9::unconfigured();
+    let mut d = A9::new_unconfigured();
     d.configure(&c, 0).unwrap();
     let base = frames(41, 1, M).remove(0);
     let just_out = f32::from_bits(lim.to_bits() + 1);

@@ -32,15 +32,13 @@ use cortex_m_semihosting::hprintln;
 use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::cbmember::CbmemberTbd;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
-use faint_core::detect::dp::{
-    arnold_words, pulford_words, second_order_words, ArnoldDp, DpConfig, DpTrack, Method,
-    PulfordDp, SecondOrderDp,
-};
+use faint_core::detect::dp::{DpConfig, DpTrack, Method};
 use faint_core::detect::mht::{MhtConfig, MhtTbd};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint_core::detect::phd::SmcPhdTbd;
 use faint_core::detect::Detector;
+use faint_core::dp_tbd;
 use faint_core::model::doppler::{DopplerModel, DopplerReport, Window};
 use faint_core::model::plot::Plot;
 use faint_core::model::range_doppler::PointModel;
@@ -479,9 +477,9 @@ fn cbmember() {
 }
 
 const M: usize = 128;
-type A9 = ArnoldDp<M, 9, 8, { arnold_words(M, 9, 8) }>;
-type P9 = PulfordDp<M, 9, 8, { pulford_words(M, 9, 8) }>;
-type S9 = SecondOrderDp<M, 9, 8, { second_order_words(M, 9, 8) }>;
+type A9 = dp_tbd!(Arnold, M, 9, 8);
+type P9 = dp_tbd!(Pulford, M, 9, 8);
+type S9 = dp_tbd!(SecondOrder, M, 9, 8);
 #[link_section = ".psram"]
 static mut DP_A9: MaybeUninit<A9> = MaybeUninit::uninit();
 #[link_section = ".psram"]

@@ -21,32 +21,30 @@ faint_firmware::panic_never!();
 use core::hint::black_box;
 
 use cortex_m_rt::entry;
-use faint_core::detect::dp::{
-    arnold_words, pulford_words, second_order_words, ArnoldDp, DpConfig, DpTrack, Method,
-    PulfordDp, SecondOrderDp, Transition,
-};
+use faint_core::detect::dp::{DpConfig, DpTrack, Method, Transition};
 use faint_core::detect::Detector;
+use faint_core::dp_tbd;
 use faint_core::rng::Rng;
 use faint_firmware::semihosting::finish;
 
 const M: usize = 16;
 const L: usize = 5;
 
-type A9 = ArnoldDp<M, 9, L, { arnold_words(M, 9, L) }>;
-type A25i8 = ArnoldDp<M, 25, L, { arnold_words(M, 25, L) }, i8>;
-type P9 = PulfordDp<M, 9, L, { pulford_words(M, 9, L) }>;
-type P25 = PulfordDp<M, 25, L, { pulford_words(M, 25, L) }>;
-type S9 = SecondOrderDp<M, 9, L, { second_order_words(M, 9, L) }>;
-type S9i8 = SecondOrderDp<M, 9, L, { second_order_words(M, 9, L) }, i8>;
-type S25 = SecondOrderDp<M, 25, L, { second_order_words(M, 25, L) }>;
+type A9 = dp_tbd!(Arnold, M, 9, L);
+type A25i8 = dp_tbd!(Arnold, M, 25, L, i8);
+type P9 = dp_tbd!(Pulford, M, 9, L);
+type P25 = dp_tbd!(Pulford, M, 25, L);
+type S9 = dp_tbd!(SecondOrder, M, 9, L);
+type S9i8 = dp_tbd!(SecondOrder, M, 9, L, i8);
+type S25 = dp_tbd!(SecondOrder, M, 25, L);
 
-static mut A9_DET: A9 = A9::unconfigured();
-static mut A25_DET: A25i8 = A25i8::unconfigured();
-static mut P9_DET: P9 = P9::unconfigured();
-static mut P25_DET: P25 = P25::unconfigured();
-static mut S9_DET: S9 = S9::unconfigured();
-static mut S9I8_DET: S9i8 = S9i8::unconfigured();
-static mut S25_DET: S25 = S25::unconfigured();
+static mut A9_DET: A9 = A9::new_unconfigured();
+static mut A25_DET: A25i8 = A25i8::new_unconfigured();
+static mut P9_DET: P9 = P9::new_unconfigured();
+static mut P25_DET: P25 = P25::new_unconfigured();
+static mut S9_DET: S9 = S9::new_unconfigured();
+static mut S9I8_DET: S9i8 = S9i8::new_unconfigured();
+static mut S25_DET: S25 = S25::new_unconfigured();
 
 #[entry]
 fn main() -> ! {

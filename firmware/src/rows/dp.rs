@@ -23,10 +23,8 @@ use core::hint::black_box;
 use core::mem::{align_of, size_of, MaybeUninit};
 
 use cortex_m_semihosting::hprintln;
-use faint_core::detect::dp::{
-    arnold_words, pulford_words, second_order_words, ArnoldDp, DpConfig, DpTrack, Method,
-    PulfordDp, SecondOrderDp,
-};
+use faint_core::detect::dp::{DpConfig, DpTrack, Method};
+use faint_core::dp_tbd;
 use faint_core::rng::Rng;
 use faint_golden::dp::{frame, target, SIGMA};
 
@@ -43,12 +41,12 @@ const FRAMES: usize = 8;
 /// term in the second order).
 const WARM: usize = 2;
 
-type A9 = ArnoldDp<M, 9, L, { arnold_words(M, 9, L) }>;
-type A9i8 = ArnoldDp<M, 9, L, { arnold_words(M, 9, L) }, i8>;
-type A25 = ArnoldDp<M, 25, L, { arnold_words(M, 25, L) }>;
-type P9 = PulfordDp<M, 9, L, { pulford_words(M, 9, L) }>;
-type S9 = SecondOrderDp<M, 9, L, { second_order_words(M, 9, L) }>;
-type S9i8 = SecondOrderDp<M, 9, L, { second_order_words(M, 9, L) }, i8>;
+type A9 = dp_tbd!(Arnold, M, 9, L);
+type A9i8 = dp_tbd!(Arnold, M, 9, L, i8);
+type A25 = dp_tbd!(Arnold, M, 25, L);
+type P9 = dp_tbd!(Pulford, M, 9, L);
+type S9 = dp_tbd!(SecondOrder, M, 9, L);
+type S9i8 = dp_tbd!(SecondOrder, M, 9, L, i8);
 
 const fn max(a: usize, b: usize) -> usize {
     if a > b {

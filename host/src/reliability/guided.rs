@@ -37,10 +37,7 @@ use arbitrary::Unstructured;
 use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::cbmember::{CbmemberConfig, CbmemberTbd, Likelihood};
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd, Weighting};
-use faint_core::detect::dp::{
-    arnold_words, pulford_words, second_order_words, ArnoldDp, DpConfig, Method, PulfordDp,
-    SecondOrderDp, Transition,
-};
+use faint_core::detect::dp::{DpConfig, Method, Transition};
 use faint_core::detect::mht::{ClassicHoughConfig, MhtConfig};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd};
@@ -59,6 +56,9 @@ use super::frames::{self, complex, len_or_short, plots, reals, Mode, BAD, EXTREM
 use super::mutate::{FLOATS, INTS};
 use super::{check_outputs, outputs, twin_check, Kind};
 use crate::instances::mht::{Classic, Mht, PLOTS as MHT_PLOTS};
+use crate::simulate::dp::fuzz::{
+    Arnold25, Arnold9, Pulford25, Pulford9, Second25, Second9, SIDE as DP_SIDE,
+};
 use crate::simulate::phd::{SixTargets, Variant};
 
 /// What one input did (for the fuzz targets' statistics and the replay tests).
@@ -527,26 +527,6 @@ pub const PHD_CUBE: [usize; 3] = [10, 10, 8];
 pub type Cbm = CbmemberTbd<4, 128, 512, [f32]>;
 /// CBMeMBer map: range x velocity bins over the preset's extent.
 pub const CBM_MAP: [usize; 2] = [32, 64];
-
-/// DP-TBD image side and recoverable track length.
-pub const DP_SIDE: usize = 32;
-/// See [`DP_SIDE`].
-pub const DP_HISTORY: usize = 8;
-type Arnold<const Q: usize, const W: usize> = ArnoldDp<DP_SIDE, Q, DP_HISTORY, W>;
-type Pulford<const Q: usize, const W: usize> = PulfordDp<DP_SIDE, Q, DP_HISTORY, W>;
-type Second<const Q: usize, const W: usize> = SecondOrderDp<DP_SIDE, Q, DP_HISTORY, W>;
-/// Arnold, `q_B = 9` and `25`.
-pub type Arnold9 = Arnold<9, { arnold_words(DP_SIDE, 9, DP_HISTORY) }>;
-/// See [`Arnold9`].
-pub type Arnold25 = Arnold<25, { arnold_words(DP_SIDE, 25, DP_HISTORY) }>;
-/// Pulford, `q_B = 9` and `25`.
-pub type Pulford9 = Pulford<9, { pulford_words(DP_SIDE, 9, DP_HISTORY) }>;
-/// See [`Pulford9`].
-pub type Pulford25 = Pulford<25, { pulford_words(DP_SIDE, 25, DP_HISTORY) }>;
-/// Second order, `q_B = 9` and `25`.
-pub type Second9 = Second<9, { second_order_words(DP_SIDE, 9, DP_HISTORY) }>;
-/// See [`Second9`].
-pub type Second25 = Second<25, { second_order_words(DP_SIDE, 25, DP_HISTORY) }>;
 
 /// Largest frame a generator draws (a configuration asking for more gets short frames).
 const MAX_FRAME: usize = 1 << 16;

@@ -9,10 +9,7 @@ use anyhow::{anyhow, bail, Result};
 use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::cbmember::CbmemberConfig;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
-use faint_core::detect::dp::{
-    arnold_words, pulford_words, second_order_words, ArnoldDp, DpConfig, Method, PulfordDp,
-    SecondOrderDp,
-};
+use faint_core::detect::dp::{DpConfig, Method};
 use faint_core::detect::mht::MhtConfig;
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
@@ -21,7 +18,7 @@ use faint_core::detect::Detector;
 use faint_core::model::range_doppler::PointModel;
 use faint_core::rng::Rng;
 use faint_golden::soak::{
-    cbmember_reduced, cube_cells, CLASSIC_PLOTS, DP_REDUCED_SIDE, DP_SCALE, PHD_REDUCED_CELLS,
+    cbmember_reduced, cube_cells, CLASSIC_PLOTS, DP_SCALE, PHD_REDUCED_CELLS,
 };
 use serde::Serialize;
 use serde_json::Value;
@@ -121,26 +118,10 @@ pub fn cbmember_config(model: PointModel, shape: Shape) -> CbmemberConfig {
 }
 
 /// Side of [`Shape::Reduced`]'s DP-TBD images.
-pub const REDUCED_SIDE: usize = DP_REDUCED_SIDE;
-
-type Arnold32 =
-    ArnoldDp<REDUCED_SIDE, 9, { sdp::HISTORY }, { arnold_words(REDUCED_SIDE, 9, sdp::HISTORY) }>;
-type Pulford32 =
-    PulfordDp<REDUCED_SIDE, 9, { sdp::HISTORY }, { pulford_words(REDUCED_SIDE, 9, sdp::HISTORY) }>;
-type Second32 = SecondOrderDp<
-    REDUCED_SIDE,
-    9,
-    { sdp::HISTORY },
-    { second_order_words(REDUCED_SIDE, 9, sdp::HISTORY) },
->;
-
-// SAFETY: the same types as `simulate::dp`'s (integers, floats, bools, fieldless enums
-// whose first variant is 0), on a smaller image: their `unconfigured()` is all zeros.
-unsafe impl sdp::ZeroValid for Arnold32 {}
-// SAFETY: as above.
-unsafe impl sdp::ZeroValid for Pulford32 {}
-// SAFETY: as above.
-unsafe impl sdp::ZeroValid for Second32 {}
+pub use faint_core::detect::dp::preset::REDUCED_SIDE;
+use faint_core::detect::dp::preset::{
+    Arnold9Reduced as Arnold32, Pulford9Reduced as Pulford32, Second9Reduced as Second32,
+};
 
 fn image_reduced(rng: &mut Rng, _c: &DpConfig, mode: Mode) -> Vec<f32> {
     reals(rng, REDUCED_SIDE * REDUCED_SIDE, mode, DP_SCALE, false)
@@ -191,9 +172,7 @@ where
     }
 }
 
-fn boxed2<D: faint_core::detect::dp::DpTrack + sdp::ZeroValid>(
-    c: &DpConfig,
-) -> Result<(Box<D>, Box<D>)> {
+fn boxed2<D: faint_core::detect::dp::DpTrack>(c: &DpConfig) -> Result<(Box<D>, Box<D>)> {
     Ok((sdp::boxed::<D>(c)?, sdp::boxed::<D>(c)?))
 }
 

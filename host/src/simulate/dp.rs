@@ -22,52 +22,14 @@
 //!   `L = 40` frames, so the whole track is recovered.
 
 use anyhow::{anyhow, bail, ensure, Result};
-use faint_core::detect::dp::{
-    arnold_words, pulford_words, second_order_words, ArnoldDp, DpConfig, DpTrack, Method,
-    PulfordDp, SecondOrderDp,
-};
+use faint_core::detect::dp::{DpConfig, DpTrack, Method};
+use faint_core::dp_tbd;
 use faint_core::rng::{derive_seed, Rng};
 use serde::Serialize;
 
-/// Image side `M` the host detectors are compiled for.
-pub const SIDE: usize = 128;
-/// Recoverable track length `L` (frames) of the host detectors: the whole run.
-pub const HISTORY: usize = 40;
-
-/// Arnold, `q_B = 9`.
-pub type Arnold9 = ArnoldDp<SIDE, 9, HISTORY, { arnold_words(SIDE, 9, HISTORY) }>;
-/// Arnold, `q_B = 25`.
-pub type Arnold25 = ArnoldDp<SIDE, 25, HISTORY, { arnold_words(SIDE, 25, HISTORY) }>;
-/// Pulford, `q_B = 9`.
-pub type Pulford9 = PulfordDp<SIDE, 9, HISTORY, { pulford_words(SIDE, 9, HISTORY) }>;
-/// Pulford, `q_B = 25`.
-pub type Pulford25 = PulfordDp<SIDE, 25, HISTORY, { pulford_words(SIDE, 25, HISTORY) }>;
-/// Second order, `q_B = 9`.
-pub type Second9 = SecondOrderDp<SIDE, 9, HISTORY, { second_order_words(SIDE, 9, HISTORY) }>;
-/// Second order, `q_B = 25`.
-pub type Second25 = SecondOrderDp<SIDE, 25, HISTORY, { second_order_words(SIDE, 25, HISTORY) }>;
-
-/// Detector types whose all-zero bytes are a valid value (the core's documented
-/// zeroed-static construction), so [`boxed`] may build them zeroed on the heap.
-///
-/// # Safety
-/// Every field of an implementing type must be an integer, a float, a bool, a fieldless
-/// enum with a zero discriminant, or an array or struct of those.
-pub unsafe trait ZeroValid {}
-
-// SAFETY: the DP detectors hold only integers, floats, bools, fieldless enums whose first
-// variant is 0, and arrays and structs of those (their `unconfigured()` is all zeros).
-unsafe impl ZeroValid for Arnold9 {}
-// SAFETY: as above.
-unsafe impl ZeroValid for Arnold25 {}
-// SAFETY: as above.
-unsafe impl ZeroValid for Pulford9 {}
-// SAFETY: as above.
-unsafe impl ZeroValid for Pulford25 {}
-// SAFETY: as above.
-unsafe impl ZeroValid for Second9 {}
-// SAFETY: as above.
-unsafe impl ZeroValid for Second25 {}
+pub use faint_core::detect::dp::preset::{
+    Arnold25, Arnold9, Pulford25, Pulford9, Second25, Second9, HISTORY, SIDE,
+};
 
 /// Image sides `M` of the host detectors of `faint detect dp-*`, smallest first: an
 /// `H x W` image runs on the smallest that holds `max(H, W)`, padded (see
@@ -86,46 +48,55 @@ pub fn capacity(h: usize, w: usize) -> Option<usize> {
 /// Defines the larger host detectors (only ever built in place by [`boxed`]: they are
 /// larger than a thread's stack).
 macro_rules! sized {
-    ($($name:ident = $ty:ident, $words:ident, $m:literal, $q:literal;)*) => {$(
-        #[doc = concat!("`", stringify!($ty), "` at `M = ", stringify!($m), "`, `q_B = ", stringify!($q), "`.")]
-        pub type $name = $ty<$m, $q, HISTORY, { $words($m, $q, HISTORY) }>;
-        // SAFETY: as for the `M = 128` types above.
-        unsafe impl ZeroValid for $name {}
+    ($($name:ident = $method:ident, $m:literal, $q:literal;)*) => {$(
+        #[doc = concat!("`", stringify!($method), "` at `M = ", stringify!($m), "`, `q_B = ", stringify!($q), "`.")]
+        pub type $name = dp_tbd!($method, $m, $q, HISTORY);
     )*};
 }
 
 sized! {
-    Arnold9At256 = ArnoldDp, arnold_words, 256, 9;
-    Arnold25At256 = ArnoldDp, arnold_words, 256, 25;
-    Pulford9At256 = PulfordDp, pulford_words, 256, 9;
-    Pulford25At256 = PulfordDp, pulford_words, 256, 25;
-    Second9At256 = SecondOrderDp, second_order_words, 256, 9;
-    Second25At256 = SecondOrderDp, second_order_words, 256, 25;
-    Arnold9At512 = ArnoldDp, arnold_words, 512, 9;
-    Arnold25At512 = ArnoldDp, arnold_words, 512, 25;
-    Pulford9At512 = PulfordDp, pulford_words, 512, 9;
-    Pulford25At512 = PulfordDp, pulford_words, 512, 25;
-    Second9At512 = SecondOrderDp, second_order_words, 512, 9;
-    Second25At512 = SecondOrderDp, second_order_words, 512, 25;
+    Arnold9At256 = Arnold, 256, 9;
+    Arnold25At256 = Arnold, 256, 25;
+    Pulford9At256 = Pulford, 256, 9;
+    Pulford25At256 = Pulford, 256, 25;
+    Second9At256 = SecondOrder, 256, 9;
+    Second25At256 = SecondOrder, 256, 25;
+    Arnold9At512 = Arnold, 512, 9;
+    Arnold25At512 = Arnold, 512, 25;
+    Pulford9At512 = Pulford, 512, 9;
+    Pulford25At512 = Pulford, 512, 25;
+    Second9At512 = SecondOrder, 512, 9;
+    Second25At512 = SecondOrder, 512, 25;
 }
 
-/// A configured DP detector built on the heap: zeroed in place (the `q_B = 25` second
-/// order is 6.2 MB, more than a thread's stack), then configured with `cfg`.
-pub fn boxed<D: DpTrack + ZeroValid>(cfg: &DpConfig) -> Result<Box<D>> {
-    let layout = std::alloc::Layout::new::<D>();
-    if layout.size() == 0 {
-        anyhow::bail!("a DP detector cannot be zero-sized");
-    }
-    // SAFETY: the layout has a non-zero size; a null pointer is handled; all-zero bytes
-    // are a valid `D` (`ZeroValid`), and the allocation was made with `D`'s layout by the
-    // global allocator, as `Box::from_raw` requires.
-    let mut d: Box<D> = unsafe {
-        let p = std::alloc::alloc_zeroed(layout);
-        if p.is_null() {
-            std::alloc::handle_alloc_error(layout);
-        }
-        Box::from_raw(p.cast::<D>())
-    };
+/// The DP detectors of the fuzzing targets (`reliability::guided`): small images, short
+/// tracks, so a campaign runs many frames.
+pub mod fuzz {
+    use faint_core::dp_tbd;
+
+    /// Image side `M`.
+    pub const SIDE: usize = 32;
+    /// Recoverable track length `L` (frames).
+    pub const HISTORY: usize = 8;
+    /// Arnold, `q_B = 9`.
+    pub type Arnold9 = dp_tbd!(Arnold, SIDE, 9, HISTORY);
+    /// Arnold, `q_B = 25`.
+    pub type Arnold25 = dp_tbd!(Arnold, SIDE, 25, HISTORY);
+    /// Pulford, `q_B = 9`.
+    pub type Pulford9 = dp_tbd!(Pulford, SIDE, 9, HISTORY);
+    /// Pulford, `q_B = 25`.
+    pub type Pulford25 = dp_tbd!(Pulford, SIDE, 25, HISTORY);
+    /// Second order, `q_B = 9`.
+    pub type Second9 = dp_tbd!(SecondOrder, SIDE, 9, HISTORY);
+    /// Second order, `q_B = 25`.
+    pub type Second25 = dp_tbd!(SecondOrder, SIDE, 25, HISTORY);
+}
+
+/// A configured DP detector built on the heap, in place (the `q_B = 25` second order is
+/// 6.2 MB, more than a thread's stack): the unconfigured detector (all-zero bits; an
+/// optimised build writes it straight into the allocation), then configured with `cfg`.
+pub fn boxed<D: DpTrack>(cfg: &DpConfig) -> Result<Box<D>> {
+    let mut d = Box::new(D::new_unconfigured());
     d.configure(cfg, 0).map_err(|e| anyhow!("{e}"))?;
     Ok(d)
 }
@@ -487,7 +458,7 @@ mod tests {
     /// docs/dp.md (`cargo test -p faint --lib -- larger_dp --nocapture`).
     #[test]
     fn larger_dp_detectors_build_in_place() {
-        fn build<D: DpTrack + ZeroValid>(method: Method, q: usize) -> (String, usize) {
+        fn build<D: DpTrack>(method: Method, q: usize) -> (String, usize) {
             let cfg = DpConfig::dim_point(method, 1);
             let d = boxed::<D>(&cfg).unwrap();
             assert_eq!(d.frames(), 0);

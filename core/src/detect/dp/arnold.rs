@@ -24,11 +24,10 @@
 //! back-pointers (`b = 4` for `q_B = 9`: 8 KiB per frame at `M = 128`) and the fixed
 //! fields: `M^2 c + 44 M + 4 W + 144` bytes.
 
-use super::{
-    begin, bits_for, check_shape, detection, finish, radius_of, read_bits, BitWriter, DpConfig,
-    DpReport, DpTrack, Ends, MeritCell, Method, Quant, Tally, TrackEnd, MAGIC, MAGIC_BITS, STATE,
-};
-use crate::detect::{Detection, Detector, ScoreKind};
+use super::bits::{bits_for, code_at, radius_of, BitWriter};
+use super::config::{DpConfig, Method};
+use super::detector::{DpTbd, Recursion, Tally};
+use super::quant::{MeritCell, Quant, MAGIC, MAGIC_BITS};
 use crate::Result;
 
 /// Bits of one back-pointer for a `q_B`-pixel window.
@@ -58,7 +57,7 @@ fn round_q(z: f32, inv: f32) -> i32 {
     ((z * inv + MAGIC).to_bits() as i32).wrapping_sub(MAGIC_BITS)
 }
 
-/// One pixel pair of the 3x3 column pass ([`ArnoldDp::col3`]), portable; `best` a plain
+/// One pixel pair of the 3x3 column pass (`ArnoldRecursion::col3`), portable; `best` a plain
 /// maximum, the back-pointers into nibble `i` of `acc0`, `acc1`.
 #[inline(always)]
 fn px3<C: MeritCell, const ROT: bool>(
@@ -249,23 +248,26 @@ fn put_bits(words: &mut [u32], bit: usize, v: u32, n: u32) {
 
 /// First-order DP-TBD on `M x M` images with a `q_B = QB` window (9, 25 or 49), tracks
 /// recoverable over `L` frames, `W = arnold_words(M, QB, L)` back-pointer words, merits
-/// stored as `C`.
-///
-/// Build small instances with [`ArnoldDp::new`]; large ones zeroed in a `static` (or a
-/// `Box`) with [`ArnoldDp::unconfigured`] and then [`Detector::configure`].
+/// stored as `C`: a [`DpTbd`] over an [`ArnoldRecursion`]. Name an instance with
+/// [`dp_tbd!`](crate::dp_tbd)`(Arnold, SIDE, WINDOW, HISTORY)` (which computes `W`).
+pub type ArnoldDp<
+    const SIDE: usize,
+    const WINDOW: usize,
+    const HISTORY: usize,
+    const WORDS: usize,
+    C = i16,
+> = DpTbd<ArnoldRecursion<SIDE, WINDOW, HISTORY, WORDS, C>>;
+
+/// The merits and back-pointers of [`ArnoldDp`] (`M = SIDE`, `q_B = WINDOW`,
+/// `L = HISTORY`, `W = WORDS`).
 #[derive(Debug, Clone)]
-pub struct ArnoldDp<
+pub struct ArnoldRecursion<
     const M: usize,
     const QB: usize,
     const L: usize,
     const W: usize,
     C: MeritCell = i16,
 > {
-    cfg: DpConfig,
-    configured: bool,
-    quant: Quant,
-    tally: Tally,
-    ends: Ends,
     merit: [[C; M]; M],
     hring: [[i32; M]; RING + 1],
     kbuf: [i32; M],
@@ -274,7 +276,7 @@ pub struct ArnoldDp<
 }
 
 impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCell>
-    ArnoldDp<M, QB, L, W, C>
+    ArnoldRecursion<M, QB, L, W, C>
 {
     const R: usize = radius_of(QB);
     const PB: u32 = if Self::R <= 1 { 2 } else { 3 };
@@ -290,41 +292,6 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         W == Self::LP * Self::WF,
         "W must be dp::arnold_words(M, QB, L)"
     );
-
-    /// A detector for `cfg` (validated here). Large shapes: see the type docs.
-    pub fn new(cfg: DpConfig) -> Result<Self> {
-        let mut d = Self::unconfigured();
-        d.configure(&cfg, 0)?;
-        Ok(d)
-    }
-
-    /// A zeroed detector for `static` storage; `step` returns
-    /// `Error::InvalidConfig("unconfigured")` until [`Detector::configure`] succeeds.
-    pub const fn unconfigured() -> Self {
-        let () = Self::SHAPE;
-        Self {
-            cfg: DpConfig::dim_point(Method::Arnold, 1),
-            configured: false,
-            quant: Quant::zero(),
-            tally: Tally::new(),
-            ends: Ends::new(),
-            merit: [[C::ZERO; M]; M],
-            hring: [[0; M]; RING + 1],
-            kbuf: [0; M],
-            zrow: [0; M],
-            ptr: [0; W],
-        }
-    }
-
-    /// The distinct track ends of the last frame, best first ([`DpConfig::top_k`]).
-    pub fn ends(&self) -> &[TrackEnd] {
-        self.ends.as_slice()
-    }
-
-    #[inline]
-    fn raw(&self, x: usize, y: usize) -> Option<i32> {
-        self.merit.get(y)?.get(x).map(|c| c.get())
-    }
 
     /// Row keys of merit row `r` into `dst` (max over the clipped row window).
     fn h_row(src: &[C; M], r: usize, dst: &mut [i32; M], kbuf: &mut [i32; M]) {
@@ -670,8 +637,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     /// per column pass. Its keys are those of [`Self::h_row3`] less `sub << 4` (so the
     /// winners and back-pointers are the same); the row maxima of four rows are held
     /// interleaved per pixel. Returns the best stored merit and its pixel.
-    fn run3(&mut self, frame: &[f32], sub: i32, slot: usize) -> (i32, (u16, u16)) {
-        let inv = self.quant.inv_lsb;
+    fn run3(&mut self, frame: &[f32], inv: f32, sub: i32, slot: usize) -> (i32, (u16, u16)) {
         let off = sub.wrapping_shl(4);
         let base = |r: usize| (((r & 3) << 2) as i32).wrapping_sub(off);
         let cells = self.hring.as_flattened_mut();
@@ -730,17 +696,50 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         }
         (best, bxy)
     }
+}
 
-    /// The recursion on one frame (checked).
-    fn run(&mut self, frame: &[f32], slow: bool) {
-        let k = self.tally.frames + 1;
-        let sub = if k == 1 { 0 } else { self.tally.best_raw };
+impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCell> Recursion
+    for ArnoldRecursion<M, QB, L, W, C>
+{
+    const SIDE: usize = M;
+    const HISTORY: usize = L;
+    const METHOD: Method = Method::Arnold;
+    const ZMAX: i32 = C::ZMAX;
+    const RADIUS: usize = Self::R;
+    const UNCONFIGURED: Self = {
+        let () = Self::SHAPE;
+        Self {
+            merit: [[C::ZERO; M]; M],
+            hring: [[0; M]; RING + 1],
+            kbuf: [0; M],
+            zrow: [0; M],
+            ptr: [0; W],
+        }
+    };
+    type Track = [[u16; 2]; L];
+    const NO_TRACK: Self::Track = [[0; 2]; L];
+
+    fn configure(&mut self, _cfg: &DpConfig) -> Result<()> {
+        let () = Self::SHAPE;
+        Ok(())
+    }
+
+    fn run(
+        &mut self,
+        frame: &[f32],
+        slow: bool,
+        _cfg: &DpConfig,
+        quant: &Quant,
+        tally: &mut Tally,
+    ) {
+        let k = tally.frames + 1;
+        let sub = if k == 1 { 0 } else { tally.best_raw };
         let mut clamped = 0u32;
         let mut best = i32::MIN;
         let mut bxy = (0u16, 0u16);
         if k == 1 {
             for (y, (row, src)) in self.merit.iter_mut().zip(frame.chunks_exact(M)).enumerate() {
-                clamped += self.quant.row(src, 0, slow, &mut self.zrow);
+                clamped += quant.row(src, 0, slow, &mut self.zrow);
                 for (x, (c, &q)) in row.iter_mut().zip(self.zrow.iter()).enumerate() {
                     *c = C::sat(q);
                     let v = c.get();
@@ -754,8 +753,8 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             let r = Self::R;
             let slot = ((k - 2) as usize) % Self::LP.max(1);
             if !slow && r == 1 && M % 2 == 0 {
-                (best, bxy) = self.run3(frame, sub, slot);
-                self.tally.advance(sub, best, bxy, clamped);
+                (best, bxy) = self.run3(frame, quant.inv_lsb, sub, slot);
+                tally.advance(sub, best, bxy, clamped);
                 return;
             }
             self.hring[RING] = [FLOOR_KEY; M];
@@ -786,10 +785,10 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                     continue;
                 };
                 let (rb, rx) = if slow {
-                    clamped += self.quant.row(src, sub, true, &mut self.zrow);
+                    clamped += quant.row(src, sub, true, &mut self.zrow);
                     Self::col_row(&rows, &self.zrow, |&q| q, y, row, &mut bw)
                 } else {
-                    let quant = self.quant;
+                    let quant = *quant;
                     Self::col_row(&rows, src, |&z| quant.fast(z, base), y, row, &mut bw)
                 };
                 if rb > best {
@@ -799,97 +798,25 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             }
             bw.finish();
         }
-        self.tally.advance(sub, best, bxy, clamped);
-    }
-}
-
-impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCell> Detector
-    for ArnoldDp<M, QB, L, W, C>
-{
-    type Frame = [f32];
-    type Config = DpConfig;
-    type Report = DpReport;
-    const STATE: &'static [&'static str] = STATE;
-    const SCORE: ScoreKind = ScoreKind::Merit;
-
-    /// Checks `cfg` (method `Arnold`, `L >= 1`, a 9/25/49 window no larger than the
-    /// image) and restarts in place. No random numbers: `seed` is unused.
-    fn configure(&mut self, cfg: &DpConfig, _seed: u64) -> Result<()> {
-        let () = Self::SHAPE;
-        check_shape(cfg, Method::Arnold, M, Self::R, L)?;
-        let quant = Quant::new(cfg.lsb, C::ZMAX)?;
-        self.cfg = *cfg;
-        self.quant = quant;
-        self.configured = true;
-        self.reset(0);
-        Ok(())
+        tally.advance(sub, best, bxy, clamped);
     }
 
-    fn config(&self) -> &DpConfig {
-        &self.cfg
+    #[inline]
+    fn raw(&self, x: usize, y: usize) -> Option<i32> {
+        self.merit.get(y)?.get(x).map(|c| c.get())
     }
 
-    /// Restarts from frame 0 (merits and back-pointers are overwritten before use).
-    fn reset(&mut self, _seed: u64) {
-        self.tally = Tally::new();
-        self.ends = Ends::new();
-    }
-
-    /// One `M x M` frame, row-major.
-    fn step(&mut self, frame: &[f32]) -> Result<DpReport> {
-        let slow = begin(self.configured, &self.quant, frame, M)?;
-        self.run(frame, slow);
-        let mut ends = self.ends;
-        let r = finish(&self.cfg, &self.tally, &mut ends, M, |x, y| self.raw(x, y));
-        self.ends = ends;
-        Ok(r)
-    }
-
-    fn detection_count(&self) -> usize {
-        self.ends.n as usize
-    }
-
-    fn detection(&self, i: usize) -> Option<Detection> {
-        detection::<Self, L>(self, &self.ends, i)
-    }
-}
-
-impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCell> DpTrack
-    for ArnoldDp<M, QB, L, W, C>
-{
-    const SIDE: usize = M;
-    const HISTORY: usize = L;
-
-    fn frames(&self) -> u32 {
-        self.tally.frames
-    }
-
-    fn merit(&self, x: usize, y: usize) -> Option<f32> {
-        self.tally.merit_of(self.raw(x, y), self.cfg.lsb)
-    }
-
-    fn track(&self, x: usize, y: usize, out: &mut [[u16; 2]]) -> usize {
-        let k = self.tally.frames as usize;
-        if x >= M || y >= M || k == 0 {
-            return 0;
-        }
-        let n = out.len().min(L).min(k);
-        let (mut x, mut y) = (x, y);
-        for (j, o) in out.iter_mut().take(n).enumerate() {
-            if j > 0 {
-                // back-pointer of frame f = k - j + 1 >= 2
-                let f = k - j + 1;
-                let slot = (f - 2) % Self::LP.max(1);
-                let bit = (slot * Self::WF) * 32 + (y * M + x) * Self::BITS as usize;
-                let code = read_bits(&self.ptr, bit, Self::BITS);
-                (x, y) = Self::pred(x, y, code);
-            }
-            *o = [x as u16, y as u16];
-        }
-        n
-    }
-
-    fn best(&self) -> Option<TrackEnd> {
-        self.ends.as_slice().first().copied()
+    /// The back-pointer of frame `f = k - j + 1 >= 2` (slot `(f - 2) mod (L - 1)`) at
+    /// position `j - 1`.
+    fn trace_back(
+        &self,
+        k: usize,
+        j: usize,
+        (x, y): (usize, usize),
+        _t: usize,
+    ) -> Option<((usize, usize), usize)> {
+        let slot = (k - j - 1) % Self::LP.max(1);
+        let code = code_at(&self.ptr, slot, Self::WF, y * M + x, Self::BITS);
+        Some((Self::pred(x, y, code), 0))
     }
 }

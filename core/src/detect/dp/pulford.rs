@@ -25,11 +25,10 @@
 //! 264 of gains, `4 W = (L - 1) ceil(M^2 b / 32) 4` of back-pointers,
 //! `b = ceil(log2(q_B + 1))` (the window index or "restart"), and 144 of fixed fields.
 
-use super::{
-    begin, bits_for, check_shape, detection, finish, radius_of, read_bits, BitWriter, DpConfig,
-    DpReport, DpTrack, Ends, MeritCell, Method, Quant, Tally, TrackEnd, MAGIC, MAGIC_BITS, STATE,
-};
-use crate::detect::{Detection, Detector, ScoreKind};
+use super::bits::{bits_for, code_at, radius_of, BitWriter};
+use super::config::{DpConfig, Method};
+use super::detector::{DpTbd, Recursion, Tally};
+use super::quant::{MeritCell, Quant, MAGIC, MAGIC_BITS};
 use crate::{Error, Result};
 
 /// Ages with their own gain; older filters use the last one.
@@ -87,20 +86,27 @@ fn round_i16(v: f32) -> i16 {
 }
 
 /// Velocity-gated first-order DP-TBD on `M x M` images with a `q_B = QB` window (9, 25
-/// or 49), tracks over `L` frames, `W = pulford_words(M, QB, L)` back-pointer words.
+/// or 49), tracks over `L` frames, `W = pulford_words(M, QB, L)` back-pointer words: a
+/// [`DpTbd`] over a [`PulfordRecursion`]. Name an instance with
+/// [`dp_tbd!`](crate::dp_tbd)`(Pulford, SIDE, WINDOW, HISTORY)` (which computes `W`).
+pub type PulfordDp<
+    const SIDE: usize,
+    const WINDOW: usize,
+    const HISTORY: usize,
+    const WORDS: usize,
+    C = i16,
+> = DpTbd<PulfordRecursion<SIDE, WINDOW, HISTORY, WORDS, C>>;
+
+/// The merits, Kalman filters and back-pointers of [`PulfordDp`] (`M = SIDE`,
+/// `q_B = WINDOW`, `L = HISTORY`, `W = WORDS`).
 #[derive(Debug, Clone)]
-pub struct PulfordDp<
+pub struct PulfordRecursion<
     const M: usize,
     const QB: usize,
     const L: usize,
     const W: usize,
     C: MeritCell = i16,
 > {
-    cfg: DpConfig,
-    configured: bool,
-    quant: Quant,
-    tally: Tally,
-    ends: Ends,
     gains: [[f32; 2]; AGES + 1],
     merit: [[C; M]; M],
     kf: [[Kf; M]; M],
@@ -112,7 +118,18 @@ pub struct PulfordDp<
 }
 
 impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCell>
-    PulfordDp<M, QB, L, W, C>
+    DpTbd<PulfordRecursion<M, QB, L, W, C>>
+{
+    /// The Kalman estimate `[x, y, vx, vy]` (pixel-index units) of the best track ending
+    /// at `(x, y)`, and its age (0: no velocity yet).
+    pub fn filter(&self, x: usize, y: usize) -> Option<([f32; 4], u8)> {
+        let k = self.kernel.kf.get(y)?.get(x)?;
+        Some(([k.x, k.y, k.vx, k.vy], k.age))
+    }
+}
+
+impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCell>
+    PulfordRecursion<M, QB, L, W, C>
 {
     const R: usize = radius_of(QB);
     const N: usize = 2 * Self::R + 1;
@@ -124,51 +141,6 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         W == Self::LP * Self::WF,
         "W must be dp::pulford_words(M, QB, L)"
     );
-
-    /// A detector for `cfg` (validated here).
-    pub fn new(cfg: DpConfig) -> Result<Self> {
-        let mut d = Self::unconfigured();
-        d.configure(&cfg, 0)?;
-        Ok(d)
-    }
-
-    /// A zeroed detector for `static` storage; `step` returns
-    /// `Error::InvalidConfig("unconfigured")` until [`Detector::configure`] succeeds.
-    pub const fn unconfigured() -> Self {
-        let () = Self::SHAPE;
-        Self {
-            cfg: DpConfig::dim_point(Method::Pulford, 1),
-            configured: false,
-            quant: Quant::zero(),
-            tally: Tally::new(),
-            ends: Ends::new(),
-            gains: [[0.0; 2]; AGES + 1],
-            merit: [[C::ZERO; M]; M],
-            kf: [[Kf::ZERO; M]; M],
-            mring: [[C::ZERO; M]; DELAY],
-            kring: [[Kf::ZERO; M]; DELAY],
-            zrow: [0; M],
-            codes: [0; M],
-            ptr: [0; W],
-        }
-    }
-
-    /// The distinct track ends of the last frame, best first.
-    pub fn ends(&self) -> &[TrackEnd] {
-        self.ends.as_slice()
-    }
-
-    /// The Kalman estimate `[x, y, vx, vy]` (pixel-index units) of the best track ending
-    /// at `(x, y)`, and its age (0: no velocity yet).
-    pub fn filter(&self, x: usize, y: usize) -> Option<([f32; 4], u8)> {
-        let k = self.kf.get(y)?.get(x)?;
-        Some(([k.x, k.y, k.vx, k.vy], k.age))
-    }
-
-    #[inline]
-    fn raw(&self, x: usize, y: usize) -> Option<i32> {
-        self.merit.get(y)?.get(x).map(|c| c.get())
-    }
 
     /// Gains `[K1, K2]` by age `1..=AGES` (index 0 unused) for `P0 = p0 I`.
     fn gain_table(cfg: &DpConfig) -> [[f32; 2]; AGES + 1] {
@@ -189,10 +161,46 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         }
         t
     }
+}
 
-    fn run(&mut self, frame: &[f32], slow: bool) {
-        let k = self.tally.frames + 1;
-        let sub = if k == 1 { 0 } else { self.tally.best_raw };
+impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCell> Recursion
+    for PulfordRecursion<M, QB, L, W, C>
+{
+    const SIDE: usize = M;
+    const HISTORY: usize = L;
+    const METHOD: Method = Method::Pulford;
+    const ZMAX: i32 = C::ZMAX;
+    const RADIUS: usize = Self::R;
+    const UNCONFIGURED: Self = {
+        let () = Self::SHAPE;
+        Self {
+            gains: [[0.0; 2]; AGES + 1],
+            merit: [[C::ZERO; M]; M],
+            kf: [[Kf::ZERO; M]; M],
+            mring: [[C::ZERO; M]; DELAY],
+            kring: [[Kf::ZERO; M]; DELAY],
+            zrow: [0; M],
+            codes: [0; M],
+            ptr: [0; W],
+        }
+    };
+    type Track = [[u16; 2]; L];
+    const NO_TRACK: Self::Track = [[0; 2]; L];
+
+    /// Builds the gain table.
+    fn configure(&mut self, cfg: &DpConfig) -> Result<()> {
+        let () = Self::SHAPE;
+        let gains = Self::gain_table(cfg);
+        if gains.iter().flatten().any(|g| !g.is_finite()) {
+            return Err(Error::InvalidConfig("p0"));
+        }
+        self.gains = gains;
+        Ok(())
+    }
+
+    fn run(&mut self, frame: &[f32], slow: bool, cfg: &DpConfig, quant: &Quant, tally: &mut Tally) {
+        let k = tally.frames + 1;
+        let sub = if k == 1 { 0 } else { tally.best_raw };
         let mut clamped = 0u32;
         let mut best = i32::MIN;
         let mut bxy = (0u16, 0u16);
@@ -204,7 +212,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
                 .zip(frame.chunks_exact(M))
                 .enumerate()
             {
-                clamped += self.quant.row(src, 0, slow, &mut self.zrow);
+                clamped += quant.row(src, 0, slow, &mut self.zrow);
                 for (x, ((c, f), &q)) in row
                     .iter_mut()
                     .zip(krow.iter_mut())
@@ -222,17 +230,17 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         } else {
             let r = Self::R;
             let n = Self::N;
-            let g = i32::from(self.cfg.gate);
+            let g = i32::from(cfg.gate);
             let slot = ((k - 2) as usize) % Self::LP.max(1);
             let words = self
                 .ptr
                 .get_mut(slot * Self::WF..(slot + 1) * Self::WF)
                 .unwrap_or(&mut []);
             let mut bw = BitWriter::new(words);
-            let offset = self.tally.offset;
+            let offset = tally.offset;
             let mask = (1i32 << Self::SH) - 1;
             for (y, src) in frame.chunks_exact(M).enumerate() {
-                clamped += self.quant.row(src, sub, slow, &mut self.zrow);
+                clamped += quant.row(src, sub, slow, &mut self.zrow);
                 let ds = y & (DELAY - 1);
                 for x in 0..M {
                     let mut v = FLOOR_KEY;
@@ -322,110 +330,31 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
             }
             bw.finish();
         }
-        self.tally.advance(sub, best, bxy, clamped);
+        tally.advance(sub, best, bxy, clamped);
     }
-}
 
-impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCell> Detector
-    for PulfordDp<M, QB, L, W, C>
-{
-    type Frame = [f32];
-    type Config = DpConfig;
-    type Report = DpReport;
-    const STATE: &'static [&'static str] = STATE;
-    const SCORE: ScoreKind = ScoreKind::Merit;
+    #[inline]
+    fn raw(&self, x: usize, y: usize) -> Option<i32> {
+        self.merit.get(y)?.get(x).map(|c| c.get())
+    }
 
-    /// Checks `cfg` (method `Pulford`, `L >= 1`, a 9/25/49 window no larger than the
-    /// image), builds the gain table and restarts in place. `seed` is unused.
-    fn configure(&mut self, cfg: &DpConfig, _seed: u64) -> Result<()> {
-        let () = Self::SHAPE;
-        check_shape(cfg, Method::Pulford, M, Self::R, L)?;
-        if M > 16384 {
-            return Err(Error::InvalidConfig("M"));
+    /// The back-pointer of frame `f = k - j + 1 >= 2` (slot `(f - 2) mod (L - 1)`);
+    /// `None` at a restart (the track began there).
+    fn trace_back(
+        &self,
+        k: usize,
+        j: usize,
+        (x, y): (usize, usize),
+        _t: usize,
+    ) -> Option<((usize, usize), usize)> {
+        let slot = (k - j - 1) % Self::LP.max(1);
+        let code = code_at(&self.ptr, slot, Self::WF, y * M + x, Self::BITS) as usize;
+        if code >= QB {
+            return None;
         }
-        let quant = Quant::new(cfg.lsb, C::ZMAX)?;
-        let gains = Self::gain_table(cfg);
-        if gains.iter().flatten().any(|g| !g.is_finite()) {
-            return Err(Error::InvalidConfig("p0"));
-        }
-        self.cfg = *cfg;
-        self.quant = quant;
-        self.gains = gains;
-        self.configured = true;
-        self.reset(0);
-        Ok(())
-    }
-
-    fn config(&self) -> &DpConfig {
-        &self.cfg
-    }
-
-    fn reset(&mut self, _seed: u64) {
-        self.tally = Tally::new();
-        self.ends = Ends::new();
-    }
-
-    fn step(&mut self, frame: &[f32]) -> Result<DpReport> {
-        let slow = begin(self.configured, &self.quant, frame, M)?;
-        self.run(frame, slow);
-        let mut ends = self.ends;
-        let r = finish(&self.cfg, &self.tally, &mut ends, M, |x, y| self.raw(x, y));
-        self.ends = ends;
-        Ok(r)
-    }
-
-    fn detection_count(&self) -> usize {
-        self.ends.n as usize
-    }
-
-    fn detection(&self, i: usize) -> Option<Detection> {
-        detection::<Self, L>(self, &self.ends, i)
-    }
-}
-
-impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCell> DpTrack
-    for PulfordDp<M, QB, L, W, C>
-{
-    const SIDE: usize = M;
-    const HISTORY: usize = L;
-
-    fn frames(&self) -> u32 {
-        self.tally.frames
-    }
-
-    fn merit(&self, x: usize, y: usize) -> Option<f32> {
-        self.tally.merit_of(self.raw(x, y), self.cfg.lsb)
-    }
-
-    /// Stops early at a restart (the track began there).
-    fn track(&self, x: usize, y: usize, out: &mut [[u16; 2]]) -> usize {
-        let k = self.tally.frames as usize;
-        if x >= M || y >= M || k == 0 {
-            return 0;
-        }
-        let n = out.len().min(L).min(k);
-        let (mut x, mut y) = (x, y);
         let r = Self::R;
-        for j in 0..n {
-            if j > 0 {
-                let f = k - j + 1;
-                let slot = (f - 2) % Self::LP.max(1);
-                let bit = (slot * Self::WF) * 32 + (y * M + x) * Self::BITS as usize;
-                let code = read_bits(&self.ptr, bit, Self::BITS) as usize;
-                if code >= QB {
-                    return j;
-                }
-                x = (x + code % Self::N).saturating_sub(r);
-                y = (y + code / Self::N).saturating_sub(r);
-            }
-            if let Some(o) = out.get_mut(j) {
-                *o = [x as u16, y as u16];
-            }
-        }
-        n
-    }
-
-    fn best(&self) -> Option<TrackEnd> {
-        self.ends.as_slice().first().copied()
+        let x = (x + code % Self::N).saturating_sub(r);
+        let y = (y + code / Self::N).saturating_sub(r);
+        Some(((x, y), 0))
     }
 }

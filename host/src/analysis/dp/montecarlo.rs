@@ -18,9 +18,8 @@
 
 use crate::montecarlo::run_trials;
 use anyhow::{bail, Result};
-use faint_core::detect::dp::{
-    arnold_words, second_order_words, ArnoldDp, DpConfig, DpTrack, Method, SecondOrderDp,
-};
+use faint_core::detect::dp::{DpConfig, DpTrack, Method};
+use faint_core::dp_tbd;
 use faint_core::rng::{derive_seed, Rng};
 use std::collections::BTreeMap;
 
@@ -305,14 +304,14 @@ pub const NOISE_SIDE: usize = 256;
 /// Side of the target check's images.
 pub const TARGET_SIDE: usize = 128;
 
-type A9n = ArnoldDp<NOISE_SIDE, 9, 2, { arnold_words(NOISE_SIDE, 9, 2) }>;
-type A25n = ArnoldDp<NOISE_SIDE, 25, 2, { arnold_words(NOISE_SIDE, 25, 2) }>;
-type S9n = SecondOrderDp<NOISE_SIDE, 9, 3, { second_order_words(NOISE_SIDE, 9, 3) }>;
-type S25n = SecondOrderDp<NOISE_SIDE, 25, 3, { second_order_words(NOISE_SIDE, 25, 3) }>;
-type A9t = ArnoldDp<TARGET_SIDE, 9, 2, { arnold_words(TARGET_SIDE, 9, 2) }>;
-type A25t = ArnoldDp<TARGET_SIDE, 25, 2, { arnold_words(TARGET_SIDE, 25, 2) }>;
-type S9t = SecondOrderDp<TARGET_SIDE, 9, 3, { second_order_words(TARGET_SIDE, 9, 3) }>;
-type S25t = SecondOrderDp<TARGET_SIDE, 25, 3, { second_order_words(TARGET_SIDE, 25, 3) }>;
+type A9n = dp_tbd!(Arnold, NOISE_SIDE, 9, 2);
+type A25n = dp_tbd!(Arnold, NOISE_SIDE, 25, 2);
+type S9n = dp_tbd!(SecondOrder, NOISE_SIDE, 9, 3);
+type S25n = dp_tbd!(SecondOrder, NOISE_SIDE, 25, 3);
+type A9t = dp_tbd!(Arnold, TARGET_SIDE, 9, 2);
+type A25t = dp_tbd!(Arnold, TARGET_SIDE, 25, 2);
+type S9t = dp_tbd!(SecondOrder, TARGET_SIDE, 9, 3);
+type S25t = dp_tbd!(SecondOrder, TARGET_SIDE, 25, 3);
 
 /// The detectors' side of one analysis [`Setup`](super::Setup): the noise check on
 /// [`NOISE_SIDE`]-pixel images, then the targets at the analytic and at the calibrated
@@ -344,7 +343,7 @@ pub fn check(
     macro_rules! run {
         ($n:ty, $t:ty, $r:expr) => {{
             let noise = noise_check(
-                || Box::new(<$n>::unconfigured()),
+                || Box::new(<$n>::new_unconfigured()),
                 cfg,
                 $r,
                 vt,
@@ -354,7 +353,7 @@ pub fn check(
             )?;
             let cal: Vec<f32> = noise.iter().map(|p| p.calibrated).collect();
             let mut pd = target_rates(
-                || Box::new(<$t>::unconfigured()),
+                || Box::new(<$t>::new_unconfigured()),
                 cfg,
                 $r,
                 setup.step,
