@@ -36,16 +36,6 @@ pub unsafe fn only_ref<T>(p: *mut T) -> &'static mut T {
     unsafe { &mut *p }
 }
 
-/// An all-zero `static mut`: the const evaluator rejects (compile error) a zero bit
-/// pattern that is not a valid value of every field; `configure` sets it up.
-#[allow(unused_macros)]
-macro_rules! zeroed {
-    ($name:ident: $t:ty) => {
-        // SAFETY: validity of the all-zero value is checked by const evaluation.
-        static mut $name: $t = unsafe { core::mem::MaybeUninit::zeroed().assume_init() };
-    };
-}
-
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo) -> ! {
     extern "Rust" {

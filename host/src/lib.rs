@@ -13,6 +13,7 @@
 //! - [`scenario`]: one module per paper's scene (presets are data).
 //! - [`reproduce`]: one module per paper, behind `faint reproduce <name>`.
 //! - [`detect`]: every detector on a user's files, behind `faint detect <name>`.
+//! - [`instances`]: every detector the host runs, built on the heap by one helper.
 //! - [`calibrate`]: thresholds at a false-alarm probability, behind `faint calibrate <name>`.
 //! - [`timing`]: this thread's CPU time, for measurements on a shared machine.
 //! - [`cli`]: checks and parsers of command-line values shared by every command.
@@ -26,6 +27,7 @@ pub mod analysis;
 pub mod calibrate;
 pub mod cli;
 pub mod detect;
+pub mod instances;
 pub mod io;
 pub mod montecarlo;
 pub mod physics;

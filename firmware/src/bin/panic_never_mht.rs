@@ -30,8 +30,8 @@ use cortex_m_rt::entry;
 use faint_core::detect::mht::censoring::Censor;
 use faint_core::detect::mht::dmht::{recover, Assoc};
 use faint_core::detect::mht::{
-    in_area, Accumulator, ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, Peak,
-    Track,
+    in_area, Accumulator, ClassicHough, ClassicHoughConfig, ClassicHoughHost, ClassicHoughSmall,
+    Geometry, MhtConfig, MhtTbd, MhtTbdM4, MhtTbdSmall, Peak, Track,
 };
 use faint_core::detect::{Detector, Validate};
 use faint_core::model::plot::Plot;
@@ -39,19 +39,19 @@ use faint_core::rng::Rng;
 use faint_core::scene;
 
 /// The firmware's shape (`firmware/src/mht.rs`).
-type Big = MhtTbd<512, 30, 256, 180, 16>;
+type Big = MhtTbdM4;
 /// The golden case's shape (`golden/src/mht.rs`).
-type Small = MhtTbd<48, 10, 32, 30, 4>;
-type ClassicBig = ClassicHough<256, 180, 64>;
-type ClassicSmall = ClassicHough<32, 30, 4>;
+type Small = MhtTbdSmall;
+type ClassicBig = ClassicHoughHost;
+type ClassicSmall = ClassicHoughSmall;
 
 /// Plot buffer: more than the largest capacity, for the overflow scan.
 const BUF: usize = 600;
 
-static mut BIG: Big = Big::unconfigured();
-static mut SMALL: Small = Small::unconfigured();
-zeroed!(CLASSIC_BIG: ClassicBig);
-zeroed!(CLASSIC_SMALL: ClassicSmall);
+static mut BIG: Big = Big::new_unconfigured();
+static mut SMALL: Small = Small::new_unconfigured();
+static mut CLASSIC_BIG: ClassicBig = ClassicBig::new_unconfigured();
+static mut CLASSIC_SMALL: ClassicSmall = ClassicSmall::new_unconfigured();
 static mut ACC: Accumulator<256, 180> = Accumulator::new();
 static mut CENSOR: Censor<512> = Censor::new();
 static mut FLAGS: [[u8; 512]; 8] = [[0; 512]; 8];

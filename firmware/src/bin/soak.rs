@@ -61,17 +61,17 @@ use core::sync::atomic::{AtomicBool, Ordering};
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
-use faint_core::detect::bernoulli::BernoulliTbd;
-use faint_core::detect::cbmember::{CbmemberConfig, CbmemberTbd};
+use faint_core::detect::cbmember::{CbmemberConfig, CbmemberTbdSoak};
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint_core::detect::dp::{
     arnold_words, pulford_words, second_order_words, ArnoldDp, DpConfig, Method, PulfordDp,
     SecondOrderDp,
 };
-use faint_core::detect::mht::{ClassicHough, ClassicHoughConfig, MhtConfig, MhtTbd};
+use faint_core::detect::jott::JottTbd;
+use faint_core::detect::mht::{ClassicHoughConfig, ClassicHoughHost, MhtConfig, MhtTbdHost};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint_core::detect::phd::{PhdConfig, SmcPhdTbd};
+use faint_core::detect::phd::{PhdConfig, SmcPhdTbdSoak};
 use faint_core::detect::{Detector, ScoreKind};
 use faint_core::model::doppler::DopplerReport;
 use faint_core::model::plot::Plot;
@@ -460,9 +460,11 @@ where
 }
 
 // ---------------------------------------------------------------------------------------
-// The detectors, each an all-zero `static` set up in place by `configure` (the const
-// evaluator rejects a zero bit pattern that is not a valid value of every field).
+// The detectors, each a `static` of its unconfigured constant set up in place by
+// `configure` (all-zero bits, in `.bss`, but MHT-TBD's).
 
+/// The DP detectors' all-zero `static`s (the const evaluator rejects a zero bit pattern
+/// that is not a valid value of every field).
 macro_rules! zero_static {
     ($name:ident: $t:ty) => {
         static $name: Static<$t> = Static::new(
@@ -473,10 +475,10 @@ macro_rules! zero_static {
 }
 
 const N: usize = 1000;
-type Mht = MhtTbd<640, 30, 256, 180, 32>;
-type Classic = ClassicHough<256, 180, 64>;
-type Phd = SmcPhdTbd<1024, 64, 8, 16>;
-type Cbm = CbmemberTbd<4, 100, 128, [f32]>;
+type Mht = MhtTbdHost;
+type Classic = ClassicHoughHost;
+type Phd = SmcPhdTbdSoak;
+type Cbm = CbmemberTbdSoak;
 const SIDE: usize = 128;
 const SMALL: usize = 32;
 const L: usize = 40;
@@ -484,16 +486,16 @@ type Arnold = ArnoldDp<SIDE, 9, L, { arnold_words(SIDE, 9, L) }>;
 type Pulford = PulfordDp<SMALL, 9, L, { pulford_words(SMALL, 9, L) }>;
 type Second = SecondOrderDp<SMALL, 9, L, { second_order_words(SMALL, 9, L) }>;
 
-zero_static!(CRPF: CrpfTbd<N>);
-zero_static!(PF: PfTbd<N>);
-zero_static!(JOTT: BernoulliTbd<N>);
-zero_static!(LRT: PfLrt<N>);
-zero_static!(LRT_FIXED_RATE: PfLrt<N>);
-zero_static!(LRT_FIXED_AMP: PfLrt<N>);
-static MHT: Static<Mht> = Static::new(Mht::unconfigured());
-zero_static!(CLASSIC: Classic);
-zero_static!(PHD: Phd);
-zero_static!(CBM: Cbm);
+static CRPF: Static<CrpfTbd<N>> = Static::new(CrpfTbd::new_unconfigured());
+static PF: Static<PfTbd<N>> = Static::new(PfTbd::new_unconfigured());
+static JOTT: Static<JottTbd<N>> = Static::new(JottTbd::new_unconfigured());
+static LRT: Static<PfLrt<N>> = Static::new(PfLrt::new_unconfigured());
+static LRT_FIXED_RATE: Static<PfLrt<N>> = Static::new(PfLrt::new_unconfigured());
+static LRT_FIXED_AMP: Static<PfLrt<N>> = Static::new(PfLrt::new_unconfigured());
+static MHT: Static<Mht> = Static::new(Mht::new_unconfigured());
+static CLASSIC: Static<Classic> = Static::new(Classic::new_unconfigured());
+static PHD: Static<Phd> = Static::new(Phd::new_unconfigured());
+static CBM: Static<Cbm> = Static::new(Cbm::new_unconfigured());
 zero_static!(ARNOLD: Arnold);
 zero_static!(PULFORD: Pulford);
 zero_static!(SECOND: Second);

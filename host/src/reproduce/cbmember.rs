@@ -28,6 +28,7 @@ use faint_core::rng::{derive_seed, Rng};
 use serde::Serialize;
 
 use crate::cli;
+use crate::instances::boxed;
 use crate::io::{self, plot::Series};
 use crate::montecarlo::run_trials;
 use crate::scenario::cbmember::{HostFilter, HostFilterU8, MapKind, MapSource, RotorUav};
@@ -244,8 +245,8 @@ fn one_run(sc: &RotorUav, filters: &[FilterSpec], rng: &mut Rng) -> Result<Vec<R
         let seed = rng.fork(10 + k as u64).next_u64();
         let e = |e| anyhow::anyhow!("{}: {e}", f.name);
         match f.input {
-            Input::Power => power.push(Box::new(HostFilter::new(f.cfg, seed).map_err(e)?)),
-            Input::Quantised => quant.push(Box::new(HostFilterU8::new(f.cfg, seed).map_err(e)?)),
+            Input::Power => power.push(boxed::<HostFilter>(&f.cfg, seed).map_err(e)?),
+            Input::Quantised => quant.push(boxed::<HostFilterU8>(&f.cfg, seed).map_err(e)?),
         }
     }
     let dq = Dequant::new(sc.filter.noise_var, sc.filter.quant_step);
@@ -480,10 +481,7 @@ fn timing(frames: usize, seed: u64) -> Result<Vec<TimingRow>> {
     ] {
         let mut rng = Rng::from_stream(seed, 77);
         let mut src = MapSource::new(&sc);
-        let mut f = Box::new(
-            HostFilter::new(sc.config(model, particles), seed)
-                .map_err(|e| anyhow::anyhow!("{e}"))?,
-        );
+        let mut f = boxed::<HostFilter>(&sc.config(model, particles), seed)?;
         let mut map = Vec::new();
         let mut secs = 0.0;
         let mut parts = 0usize;

@@ -41,7 +41,7 @@
 
 use std::sync::Arc;
 
-use faint_core::detect::cbmember::{gain_for_snr, CbmemberConfig, CbmemberTbd};
+use faint_core::detect::cbmember::{gain_for_snr, CbmemberConfig, CbmemberTbdHost};
 use faint_core::model::range_doppler::{
     point_velocities, simulate_power, LitTarget, PointModel, RdGeometry, RdSpread, KAPPA,
     MAX_POINTS,
@@ -52,11 +52,11 @@ use rustfft::{Fft, FftPlanner};
 use serde::Serialize;
 
 /// The host filter: 4 components of up to 1500 particles, 256 x 32 block sums, power maps.
-pub type HostFilter = CbmemberTbd<4, 1500, 8192, [f32]>;
+pub type HostFilter = CbmemberTbdHost;
 /// The same on complex maps.
-pub type HostFilterComplex = CbmemberTbd<4, 1500, 8192, [Complex32]>;
+pub type HostFilterComplex = CbmemberTbdHost<[Complex32]>;
 /// The same on quantised `u8` maps.
-pub type HostFilterU8 = CbmemberTbd<4, 1500, 8192, [u8]>;
+pub type HostFilterU8 = CbmemberTbdHost<[u8]>;
 
 /// Map generator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]

@@ -356,7 +356,7 @@ impl SixTargets {
 }
 
 /// Capacities used on the host for this preset: particles, swarm entries, points, targets.
-pub type HostFilter = faint_core::detect::phd::SmcPhdTbd<8192, 16384, 10, 16>;
+pub type HostFilter = faint_core::detect::phd::SmcPhdTbdHost;
 
 /// Which of Pei et al.'s three algorithms a configuration of the preset runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

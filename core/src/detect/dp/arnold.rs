@@ -811,6 +811,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     type Report = DpReport;
     const STATE: &'static [&'static str] = STATE;
     const SCORE: ScoreKind = ScoreKind::Merit;
+    const UNCONFIGURED: Self = Self::unconfigured();
 
     /// Checks `cfg` (method `Arnold`, `L >= 1`, a 9/25/49 window no larger than the
     /// image) and restarts in place. No random numbers: `seed` is unused.

@@ -334,6 +334,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     type Report = DpReport;
     const STATE: &'static [&'static str] = STATE;
     const SCORE: ScoreKind = ScoreKind::Merit;
+    const UNCONFIGURED: Self = Self::unconfigured();
 
     /// Checks `cfg` (method `Pulford`, `L >= 1`, a 9/25/49 window no larger than the
     /// image), builds the gain table and restarts in place. `seed` is unused.

@@ -1178,6 +1178,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
     type Report = DpReport;
     const STATE: &'static [&'static str] = STATE;
     const SCORE: ScoreKind = ScoreKind::Merit;
+    const UNCONFIGURED: Self = Self::unconfigured();
 
     /// Checks `cfg` (method `SecondOrder`, `L >= 1`, `q_B` 9 or 25 no larger than the
     /// image), builds the transition table and restarts in place. `seed` is unused.
