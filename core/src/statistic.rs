@@ -29,7 +29,7 @@ pub fn zeta_k(values: &[f32]) -> Result<f32> {
 pub fn middle_range(k: usize) -> core::ops::Range<usize> {
     match k {
         0..=2 => 0..k,
-        _ if k % 2 == 0 => k / 2 - 2..k / 2 + 2,
+        _ if k.is_multiple_of(2) => k / 2 - 2..k / 2 + 2,
         _ => (k - 1) / 2 - 1..(k - 1) / 2 + 2,
     }
 }

@@ -1,25 +1,17 @@
-//! Measurement harness: instruction counts from QEMU's virtual clock, peak stack from a
-//! painted window, `static` buffers, a Markdown table on semihosting.
+//! Measurement harness: instruction counts from the board's fine counter ([`timer`]),
+//! peak stack from a painted window, a Markdown table on semihosting.
 //!
-//! **What is counted.** QEMU does not model Cortex-M4 timing (DWT `CYCCNT` reads 0). Run
-//! with `-icount shift=10,align=off,sleep=off` (the runner in `.cargo/config.toml`),
-//! every guest instruction advances virtual time by exactly 2^10 ns, and the CMSDK
-//! timer0 (25 MHz, one tick = 40 ns) advances 25.6 ticks per instruction. So
-//!
-//! ```text
-//! instructions = round(ticks * 40 / 1024) = (ticks * 40 + 512) >> 10
-//! ```
-//!
-//! minus the count of an empty measurement. The result is an **executed-instruction
-//! count**, not Cortex-M4 cycles: loads, taken branches, divisions and FPU divides take
-//! more than one cycle on silicon and flash wait states add more. The cycle model
-//! (`tools/cycles`, the `cycles` binary) estimates Cortex-M4 and M7 cycles from QEMU's
-//! trace; on a board, build with the `dwt` feature and the same calls count cycles with
-//! DWT `CYCCNT` (enabled by `init`: `DEMCR.TRCENA`, then `DWT_CTRL.CYCCNTENA`). It is
-//! exact and deterministic: two runs print the same numbers. [`calibrate`] checks the
+//! **What is counted.** QEMU does not model Cortex-M4 timing (DWT `CYCCNT` reads 0); under
+//! `-icount` the fine counter counts executed instructions (see [`timer`]), minus the
+//! count of an empty measurement. The result is an **executed-instruction count**, not
+//! Cortex-M4 cycles: loads, taken branches, divisions and FPU divides take more than one
+//! cycle on silicon and flash wait states add more. The cycle model (`tools/cycles`, the
+//! `cycles` binary) estimates Cortex-M4 and M7 cycles from QEMU's trace; on a board, build
+//! with the `dwt` feature and the same calls count cycles with DWT `CYCCNT`. It is exact
+//! and deterministic: two runs print the same numbers. [`calibrate`] checks the
 //! conversion against a hand-written loop of known length at start-up.
 //!
-//! **Use from a detector module** (`firmware/src/<name>.rs`, one `pub fn run()` called
+//! **Use from a row module** (`firmware/src/rows/<name>.rs`, one `pub fn run()` called
 //! from `main.rs`):
 //!
 //! ```ignore
@@ -32,24 +24,16 @@
 //!
 //! Wrap inputs in `core::hint::black_box` when they are compile-time constants, or the
 //! optimiser may fold the work out of the measured region.
+//!
+//! [`timer`]: crate::timer
 
-use core::cell::UnsafeCell;
 use core::hint::black_box;
 use core::ptr::{read_volatile, write_volatile};
-use core::sync::atomic::{compiler_fence, AtomicBool, AtomicU32, Ordering};
+use core::sync::atomic::{compiler_fence, AtomicU32, Ordering};
 
-use cortex_m_rt::{exception, ExceptionFrame};
-use cortex_m_semihosting::{debug, hprintln};
+use cortex_m_semihosting::hprintln;
 
-/// CMSDK APB timer0 of the MPS2 board (not used with the `dwt` feature).
-#[cfg(not(feature = "dwt"))]
-const TIMER0: usize = 0x4000_0000;
-#[cfg(not(feature = "dwt"))]
-const TIMER_CTRL: *mut u32 = TIMER0 as *mut u32;
-#[cfg(not(feature = "dwt"))]
-const TIMER_VALUE: *mut u32 = (TIMER0 + 0x4) as *mut u32;
-#[cfg(not(feature = "dwt"))]
-const TIMER_RELOAD: *mut u32 = (TIMER0 + 0x8) as *mut u32;
+use crate::timer;
 
 /// Bytes below the stack pointer painted by [`measure`] to find the closure's peak
 /// stack. A closure that uses more is reported as `>= STACK_WINDOW`.
@@ -61,104 +45,13 @@ pub const PAINT_MARGIN: usize = 64;
 
 static BASELINE: AtomicU32 = AtomicU32::new(0);
 
-/// A `static` buffer handed out once as `&'static mut T` (large detector states live
-/// here, not on the stack). Zero-initialised values land in `.bss`.
-pub struct Static<T> {
-    taken: AtomicBool,
-    cell: UnsafeCell<T>,
-}
-
-// SAFETY: `take` hands out the only reference, at most once (atomic swap).
-unsafe impl<T: Send> Sync for Static<T> {}
-
-impl<T> Static<T> {
-    /// A buffer holding `value` (evaluated at compile time).
-    pub const fn new(value: T) -> Self {
-        Self {
-            taken: AtomicBool::new(false),
-            cell: UnsafeCell::new(value),
-        }
-    }
-
-    /// The buffer, exclusively. Panics (firmware exits with failure) on a second call.
-    // The atomic flag makes this the one `&mut` ever handed out (a `singleton!` pattern).
-    #[allow(clippy::mut_from_ref)]
-    pub fn take(&'static self) -> &'static mut T {
-        assert!(
-            !self.taken.swap(true, Ordering::AcqRel),
-            "Static::take called twice"
-        );
-        // SAFETY: the swap above guarantees this is the only `&mut` ever created.
-        unsafe { &mut *self.cell.get() }
-    }
-}
-
-/// Debug Exception and Monitor Control Register (TRCENA is bit 24).
-#[cfg(feature = "dwt")]
-const DEMCR: *mut u32 = 0xE000_EDFC as *mut u32;
-/// DWT control register (CYCCNTENA is bit 0) and the cycle counter.
-#[cfg(feature = "dwt")]
-const DWT_CTRL: *mut u32 = 0xE000_1000 as *mut u32;
-#[cfg(feature = "dwt")]
-const DWT_CYCCNT: *mut u32 = 0xE000_1004 as *mut u32;
-
-/// Starts timer0 as a free-running 32-bit down-counter and measures the empty baseline.
-/// With the `dwt` feature (silicon) it enables the cycle counter instead.
+/// Starts the fine counter ([`timer::start`]) and measures the empty baseline.
+#[inline]
 pub fn init() {
-    #[cfg(not(feature = "dwt"))]
-    // SAFETY: timer0's registers on the MPS2 memory map; nothing else uses the timer.
-    unsafe {
-        write_volatile(TIMER_CTRL, 0);
-        write_volatile(TIMER_RELOAD, u32::MAX);
-        write_volatile(TIMER_VALUE, u32::MAX);
-        write_volatile(TIMER_CTRL, 1);
-    }
-    #[cfg(feature = "dwt")]
-    // SAFETY: the architecture's debug registers (ARMv7-M C1.6.5, C1.8.7): TRCENA powers
-    // the DWT, CYCCNTENA starts the counter.
-    unsafe {
-        write_volatile(DEMCR, read_volatile(DEMCR) | 1 << 24);
-        write_volatile(DWT_CYCCNT, 0);
-        write_volatile(DWT_CTRL, read_volatile(DWT_CTRL) | 1);
-    }
+    timer::start();
     BASELINE.store(0, Ordering::Relaxed);
     let ((), base) = raw_instructions(|| ());
     BASELINE.store(base, Ordering::Relaxed);
-}
-
-#[cfg(not(feature = "dwt"))]
-#[inline(always)]
-fn timer() -> u32 {
-    // SAFETY: read of a device register.
-    unsafe { read_volatile(TIMER_VALUE) }
-}
-
-/// The cycle counter (`dwt` feature: on silicon; QEMU does not count DWT cycles).
-#[cfg(feature = "dwt")]
-#[inline(always)]
-fn timer() -> u32 {
-    // SAFETY: read of a debug register.
-    unsafe { read_volatile(DWT_CYCCNT) }
-}
-
-/// Counts between two [`timer`] reads: instructions from timer0 (a down-counter), or
-/// cycles from CYCCNT (an up-counter) with the `dwt` feature.
-#[inline(always)]
-fn elapsed(t0: u32, t1: u32) -> u32 {
-    #[cfg(not(feature = "dwt"))]
-    {
-        ticks_to_instructions(t0.wrapping_sub(t1))
-    }
-    #[cfg(feature = "dwt")]
-    {
-        t1.wrapping_sub(t0)
-    }
-}
-
-/// Timer ticks (25 MHz) to instructions at `-icount shift=10` (1024 ns each).
-#[cfg_attr(feature = "dwt", allow(dead_code))]
-pub const fn ticks_to_instructions(ticks: u32) -> u32 {
-    ((ticks as u64 * 40 + 512) >> 10) as u32
 }
 
 /// Calls `f` in a frame of its own. Without it a `step` with one call site is inlined
@@ -174,14 +67,14 @@ pub fn call<R>(f: impl FnOnce() -> R) -> R {
 #[inline(always)]
 pub fn raw_instructions<R>(f: impl FnOnce() -> R) -> (R, u32) {
     compiler_fence(Ordering::SeqCst);
-    let t0 = timer();
+    let t0 = timer::now();
     compiler_fence(Ordering::SeqCst);
     let r = black_box(call(f));
     compiler_fence(Ordering::SeqCst);
-    let t1 = timer();
+    let t1 = timer::now();
     compiler_fence(Ordering::SeqCst);
     // One wrap (167 M instructions, or 2^32 cycles) is handled by the wrapping sub.
-    (r, elapsed(t0, t1))
+    (r, timer::elapsed(t0, t1))
 }
 
 /// Result of one [`measure`].
@@ -206,6 +99,27 @@ pub fn measure<R>(f: impl FnOnce() -> R) -> (R, Measurement) {
         instructions: u64::from(total.saturating_sub(BASELINE.load(Ordering::Relaxed))),
         stack_bytes,
     };
+    (r, m)
+}
+
+/// [`measure`] for calls longer than the fine counter's wrap (167.8 M instructions, which
+/// PSO-PHD-TBD's 10-generation swarm frames reach): the coarse counter read around the
+/// measurement gives the number of wraps, the fine count the rest ([`timer::unwrap`]).
+/// Call [`timer::coarse_start`] first.
+pub fn measure_long<R>(f: impl FnOnce() -> R) -> (R, Measurement) {
+    let c0 = timer::coarse();
+    let (r, mut m) = measure(f);
+    let c1 = timer::coarse();
+    let fine = m.instructions;
+    let (total, approx) = timer::unwrap(fine, c0, c1);
+    // Self-check: the corrected count agrees with the coarse one to its resolution (plus
+    // painting and scanning the 64 KiB stack window, ~150 k), else the dual timer is not
+    // what we assume.
+    assert!(
+        total.abs_diff(approx) <= 250_000 + approx / 1000,
+        "coarse timer check failed: fine {fine}, coarse {approx}"
+    );
+    m.instructions = total;
     (r, m)
 }
 
@@ -235,6 +149,7 @@ pub fn lowest_touched(lo: usize, hi: usize) -> usize {
 /// Checks the tick-to-instruction conversion against a loop of known length: 10 000
 /// extra iterations of `subs; bne` must count exactly 20 000 more instructions. Panics
 /// otherwise (e.g. QEMU run without `-icount shift=10`).
+#[inline]
 pub fn calibrate() {
     let short = measure_spin(1_000);
     let long = measure_spin(11_000);
@@ -276,6 +191,7 @@ fn spin(n: u32) {
 }
 
 /// Prints the table header (Markdown).
+#[inline]
 pub fn table_header() {
     hprintln!("| measurement | n | instructions / call | instructions / unit | peak stack (B) | static RAM (B) |");
     hprintln!("|---|---:|---:|---:|---:|---:|");
@@ -283,6 +199,7 @@ pub fn table_header() {
 
 /// Prints one table row: `m` measured over `n` units of `unit` (e.g. 1000 "particle"),
 /// with `ram_bytes` of static buffers (`core::mem::size_of` of what the call needs).
+#[inline]
 pub fn row(name: &str, n: u32, unit: &str, m: Measurement, ram_bytes: usize) {
     let n = n.max(1);
     // One decimal, in integers (no float formatting differences between runs).
@@ -308,6 +225,7 @@ extern "C" {
 }
 
 /// Bytes of `.data` + `.bss` in this firmware image (all static buffers of all rows).
+#[inline]
 pub fn static_ram() -> usize {
     // Linker-provided section bounds from cortex-m-rt's link.x; only addresses are taken.
     (&raw const __edata as usize - &raw const __sdata as usize)
@@ -319,65 +237,5 @@ pub fn check<T, E: core::fmt::Debug>(r: Result<T, E>) -> T {
     match r {
         Ok(v) => v,
         Err(e) => panic!("measured call failed: {e:?}"),
-    }
-}
-
-/// Ends the QEMU run with exit status 0.
-pub fn exit_success() -> ! {
-    debug::exit(debug::EXIT_SUCCESS);
-    #[allow(clippy::empty_loop)]
-    loop {}
-}
-
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    hprintln!("PANIC: {}", info);
-    debug::exit(debug::EXIT_FAILURE);
-    #[allow(clippy::empty_loop)]
-    loop {}
-}
-
-#[exception]
-unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
-    hprintln!("HARDFAULT: {:?}", ef);
-    debug::exit(debug::EXIT_FAILURE);
-    #[allow(clippy::empty_loop)]
-    loop {}
-}
-
-/// A fixed-capacity string for golden lines and row labels (`core::fmt::Write`; writing
-/// past `CAP` bytes is a `fmt::Error`, never a panic).
-pub struct Text<const CAP: usize> {
-    buf: [u8; CAP],
-    len: usize,
-}
-
-impl<const CAP: usize> Text<CAP> {
-    /// Empty text.
-    pub const fn new() -> Self {
-        Self {
-            buf: [0; CAP],
-            len: 0,
-        }
-    }
-
-    /// Empties the text (keeps the buffer).
-    pub fn clear(&mut self) {
-        self.len = 0;
-    }
-
-    /// The text written so far.
-    pub fn as_str(&self) -> &str {
-        core::str::from_utf8(&self.buf[..self.len]).unwrap_or("<utf8>")
-    }
-}
-
-impl<const CAP: usize> core::fmt::Write for Text<CAP> {
-    fn write_str(&mut self, s: &str) -> core::fmt::Result {
-        let end = self.len + s.len();
-        let dst = self.buf.get_mut(self.len..end).ok_or(core::fmt::Error)?;
-        dst.copy_from_slice(s.as_bytes());
-        self.len = end;
-        Ok(())
     }
 }

@@ -4,22 +4,32 @@
 //! Run: `cd firmware && cargo run --profile firmware` (needs `qemu-system-arm`). Output
 //! goes to stdout via semihosting; the exit status is 0 on success and 1 on any panic.
 //!
-//! Adding a detector: write `firmware/src/<name>.rs` with `pub fn run()` that takes its
-//! state from a `harness::Static`, measures `step` with `harness::measure` and prints
-//! rows with `harness::row`; then add `mod <name>;` and `<name>::run();` below.
+//! Adding a detector: write `firmware/src/rows/<name>.rs` with `pub fn run()` that takes
+//! its state from a `statics::Static`, measures `step` with `harness::measure` and prints
+//! rows with `harness::row`; then add `pub mod <name>;` to `rows` and `<name>::run();`
+//! below.
 #![no_std]
 #![no_main]
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
+use faint_firmware::harness;
+use faint_firmware::semihosting::exit_success;
+use faint_firmware::text::Text;
 
-mod cbmember;
-mod crpf;
-mod dp;
-mod harness;
-mod mht;
-mod phd;
-mod primitives;
+/// The instruction table's rows, one module per detector family.
+mod rows {
+    pub mod cbmember;
+    pub mod crpf;
+    pub mod dp;
+    pub mod mht;
+    pub mod phd;
+    pub mod primitives;
+}
+
+use rows::{cbmember, crpf, dp, mht, phd, primitives};
+
+faint_firmware::report_panics!();
 
 #[entry]
 fn main() -> ! {
@@ -42,7 +52,7 @@ fn main() -> ! {
         harness::static_ram()
     );
     hprintln!();
-    let mut line = harness::Text::<1024>::new();
+    let mut line = Text::<1024>::new();
     faint_golden::cases(&mut |name, words| {
         line.clear();
         if faint_golden::write_line(&mut line, name, words).is_err() {
@@ -52,5 +62,5 @@ fn main() -> ! {
         }
     });
     hprintln!("done");
-    harness::exit_success()
+    exit_success()
 }

@@ -26,6 +26,15 @@
 //! Nothing else is needed: the firmware and the host example both print every case.
 //! Errors are emitted as the single word [`ERR`] (a `Result` that is `Err` on one side
 //! only still shows up as a diff).
+//!
+//! ## The shared fixtures
+//!
+//! The crate is also the one home of the deterministic inputs that host and target must
+//! draw alike: the detector scenes of the golden cases (which the firmware's instruction
+//! table and the host tests also run), their windows, and the soak's plausible frames and
+//! reduced configurations ([`soak`]). It depends on `faint-core` alone and is `no_std`
+//! without allocation, so the host (`faint-host`), this crate's golden cases and the
+//! firmware all use it as it is; a copy kept bit-identical by hand is what it replaces.
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -36,6 +45,7 @@ pub mod cbmember;
 pub mod crpf;
 pub mod dp;
 pub mod phd;
+pub mod soak;
 
 use faint_core::existence::ExistenceMarkov;
 use faint_core::math;

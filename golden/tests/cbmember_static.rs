@@ -1,4 +1,4 @@
-//! The firmware's CBMeMBer filter (`firmware/src/cbmember.rs`): `configure` on
+//! The firmware's CBMeMBer filter (`firmware/src/rows/cbmember.rs`): `configure` on
 //! `new_unconfigured()` (how the firmware keeps it in `.bss`) behaves exactly as `new`, and its static
 //! RAM stays within the 256 KiB goal for a 1000-particle joint filter.
 

@@ -1,7 +1,7 @@
 //! `SmcPhdTbd::reconfigure` restarts a filter in place exactly as `new` builds one,
 //! including from `new_unconfigured()` (how the firmware keeps the filter in `static`
 //! memory), for the three variants; and the firmware's configuration (window, capacities,
-//! particle counts of `firmware/src/phd.rs`) tracks the shared scene, so its instruction
+//! particle counts of `firmware/src/rows/phd.rs`) tracks the shared scene, so its instruction
 //! counts are those of a working filter.
 
 use faint_core::detect::Detector;
@@ -16,7 +16,7 @@ use faint_core::model::power_cube::CubeGeometry;
 use faint_core::rng::Rng;
 
 type Small = SmcPhdTbdSmall;
-/// The firmware's filter (`firmware/src/phd.rs`).
+/// The firmware's filter (`firmware/src/rows/phd.rs`).
 type Firmware = SmcPhdTbdM4;
 
 /// Per frame: the report, the estimates and the particles (all bits).

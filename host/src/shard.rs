@@ -7,9 +7,9 @@
 //! `floor(t i / n) .. floor(t (i + 1) / n)` of every batch ([`Shard::range`]) and writes
 //! their raw results to a shard file ([`write()`]): CBOR, whose floats round-trip bit for
 //! bit (NaN and infinities included), with the command, its full argument set, the run's
-//! fixed inputs (`meta`), the binary's version and the format version. [`read`] checks
-//! that a set of shard files is one whole run (one command, arguments, inputs and
-//! version; every shard exactly once) and joins the batches in trial order; the command
+//! fixed inputs (`meta`), the binary's version and identity ([`build_id`]) and the format
+//! version. [`read`] checks that a set of shard files is one whole run (one command,
+//! arguments, inputs, version and binary; every shard exactly once) and joins the batches in trial order; the command
 //! then computes its thresholds, rates, tables and plots from them exactly as the
 //! unsharded run does from its own.
 //!
@@ -27,7 +27,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 /// Version of the shard file layout; [`read`] refuses any other.
-pub const FORMAT: u32 = 1;
+pub const FORMAT: u32 = 2;
 
 /// Extension of shard files.
 pub const EXT: &str = "faint-shard";
@@ -43,6 +43,26 @@ const MAGIC: &str = "faint shard";
 
 /// The version written into shard files and required of them by [`read`].
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// The identity of the running binary: the FNV-1a 64-bit hash of its executable file,
+/// in hex, or `None` when the file cannot be read. Two builds of the same version from
+/// different sources (or compilers, or options) differ here, so `faint merge` refuses
+/// shards that another binary wrote even when the version matches.
+pub fn build_id() -> Option<&'static str> {
+    static ID: std::sync::OnceLock<Option<String>> = std::sync::OnceLock::new();
+    ID.get_or_init(|| {
+        let bytes = std::fs::read(std::env::current_exe().ok()?).ok()?;
+        Some(format!("{:016x}", fnv1a64(&bytes)))
+    })
+    .as_deref()
+}
+
+/// FNV-1a, 64 bits (offset basis 0xcbf29ce484222325, prime 0x100000001b3).
+fn fnv1a64(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
 
 /// Shard `index` of `count` (0-based).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -261,6 +281,8 @@ struct Header {
     magic: String,
     format: u32,
     version: String,
+    /// [`build_id`] of the binary that wrote the file.
+    build: Option<String>,
     run: Run,
     shard: Shard,
     /// Wall-clock seconds the shard's runs took.
@@ -298,6 +320,7 @@ pub fn write<T: Serialize>(
             magic: MAGIC.into(),
             format: FORMAT,
             version: VERSION.into(),
+            build: build_id().map(str::to_string),
             run: run.clone(),
             shard,
             seconds,
@@ -441,7 +464,8 @@ fn first_difference(a: &[u8], b: &[u8]) -> String {
 
 /// Reads the shard files of `inputs` ([`files`]) and joins them, after checking that
 /// they are one whole run: the same command, arguments and inputs, written by this
-/// version of faint, with every shard `0..n` exactly once and every batch's trials where
+/// version and this binary of faint ([`build_id`]; not checked where a binary cannot read
+/// its own file), with every shard `0..n` exactly once and every batch's trials where
 /// its shard puts them. Each failure is one line naming the file (or the missing shard).
 pub fn read(inputs: &[PathBuf]) -> Result<Merged> {
     let paths = files(inputs)?;
@@ -454,6 +478,13 @@ pub fn read(inputs: &[PathBuf]) -> Result<Merged> {
             p.display(),
             f.header.version
         );
+        if let (Some(theirs), Some(ours)) = (f.header.build.as_deref(), build_id()) {
+            ensure!(
+                theirs == ours,
+                "{}: written by another build of faint {VERSION} (binary {theirs}, this one is {ours}): merge with the binary that ran the shards",
+                p.display()
+            );
+        }
         loaded.push((p.clone(), f));
     }
     let (p0, f0) = &loaded[0];
@@ -718,6 +749,55 @@ mod tests {
         let want: Vec<u64> = (0..7).map(|t| value(t).to_bits()).collect();
         assert_eq!(bits, want);
         assert!(m.results::<f64>(&["b".to_string()]).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// The FNV-1a reference values (Fowler, Noll, Vo; the `""` and `"a"` test vectors).
+    #[test]
+    fn fnv1a64_matches_the_reference_vectors() {
+        assert_eq!(fnv1a64(b""), 0xcbf2_9ce4_8422_2325);
+        assert_eq!(fnv1a64(b"a"), 0xaf63_dc4c_8601_ec8c);
+        assert_eq!(fnv1a64(b"foobar"), 0x8594_4171_f739_67e8);
+    }
+
+    /// A shard of the same version but written by another binary is refused, by name;
+    /// one written by this binary (the test executable) is read.
+    #[test]
+    fn another_binarys_shards_are_refused() {
+        let ours = build_id().expect("a test binary can read itself");
+        let dir = temp("build");
+        let run = Run::new("test", &serde_json::json!({"trials": 4, "seed": 1})).unwrap();
+        let put = |index: usize, build: &str| {
+            let shard = Shard { index, count: 2 };
+            let b =
+                Batch::run("a", 4, Some(shard), |r| Ok::<_, ()>(r.collect::<Vec<_>>())).unwrap();
+            let file = FileRef {
+                header: Header {
+                    magic: MAGIC.into(),
+                    format: FORMAT,
+                    version: VERSION.into(),
+                    build: Some(build.into()),
+                    run: run.clone(),
+                    shard,
+                    seconds: 1.0,
+                },
+                batches: &[b],
+            };
+            let mut buf = Vec::new();
+            ciborium::into_writer(&file, &mut buf).unwrap();
+            std::fs::create_dir_all(&dir).unwrap();
+            std::fs::write(dir.join(shard.file_name()), buf).unwrap();
+        };
+        put(0, ours);
+        put(1, ours);
+        assert!(read(std::slice::from_ref(&dir)).is_ok());
+        put(1, "0123456789abcdef");
+        let e = read(std::slice::from_ref(&dir)).unwrap_err().to_string();
+        assert!(
+            e.contains("written by another build of faint") && e.contains("0123456789abcdef"),
+            "{e}"
+        );
+        assert!(!e.contains('\n'));
         let _ = std::fs::remove_dir_all(&dir);
     }
 

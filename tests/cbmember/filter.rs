@@ -13,6 +13,7 @@ use faint::core::model::range_doppler::{
 use faint::core::rng::Rng;
 use faint::core::{Complex32, Error};
 use faint::host::scenario::cbmember::{HostFilter, MapSource, RotorUav};
+use faint_golden::cbmember::GOLDEN_WINDOW;
 use proptest::prelude::*;
 
 /// `f64` brute force of eq. 22 over every pixel of the map: `a_ij = A sum_p g_p(i, j)`
@@ -136,17 +137,11 @@ fn log_lr_matches_f64_brute_force() {
     );
 }
 
-/// A small map for fast tests: 32 x 128 pixels around the preset's target, S = 256.
+/// A small map for fast tests: the golden case's 32 x 128 pixels around the preset's
+/// target, S = 256.
 fn small() -> CbmemberConfig {
     let mut c = CbmemberConfig::rotor_uav();
-    c.geometry = RdGeometry {
-        n_range: 32,
-        n_velocity: 128,
-        range_start: 19_997.5,
-        range_bin: 0.781_25,
-        velocity_start: -4.0,
-        velocity_bin: 0.078_125,
-    };
+    c.geometry = GOLDEN_WINDOW;
     c.max_particles = 96;
     c.min_particles = 32;
     c.birth.particles = 48;

@@ -1,5 +1,5 @@
-//! The documents are tests: every command that README.md, docs/*.md, firmware/README.md
-//! and fuzz/README.md tell a user to run.
+//! The documents are tests: every command that README.md, docs/*.md,
+//! docs/measurements/*.md, firmware/README.md and fuzz/README.md tell a user to run.
 //!
 //! `cargo test` checks that every documented command is classified (a script CI runs, a
 //! synopsis, a subcommand's name, or a block the document marks `CI skips this block:
@@ -20,6 +20,7 @@
 //! `FAINT_DOC_KEEP=1` keeps the scratch folders (their path is printed).
 
 mod extract;
+mod links;
 mod shims;
 
 use extract::{items, Item, Kind};
@@ -35,15 +36,20 @@ fn repo() -> PathBuf {
 /// The documents whose commands are tests.
 fn documents() -> Vec<String> {
     let mut docs = vec!["README.md".to_string()];
-    let mut family: Vec<String> = std::fs::read_dir(repo().join("docs"))
-        .expect("docs/")
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".md"))
-        .map(|n| format!("docs/{n}"))
-        .collect();
-    family.sort();
-    docs.extend(family);
+    // docs/*.md (the user guides) and docs/measurements/*.md (the measurement records).
+    for dir in ["docs", "docs/measurements"] {
+        let Ok(entries) = std::fs::read_dir(repo().join(dir)) else {
+            continue;
+        };
+        let mut pages: Vec<String> = entries
+            .filter_map(|e| e.ok())
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".md"))
+            .map(|n| format!("{dir}/{n}"))
+            .collect();
+        pages.sort();
+        docs.extend(pages);
+    }
     docs.push("firmware/README.md".into());
     docs.push("fuzz/README.md".into());
     docs
@@ -117,6 +123,47 @@ fn run_by_ci(command: &str, ci: &str) -> bool {
                 start_ok && (rest.is_empty() || ends.iter().any(|e| rest.starts_with(e)))
             })
         })
+}
+
+/// Every Markdown file of the repository (not under `target/` or a hidden folder).
+fn markdown_files(dir: &Path, rel: &str, out: &mut Vec<String>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.filter_map(|e| e.ok()) {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let path = if rel.is_empty() {
+            name.clone()
+        } else {
+            format!("{rel}/{name}")
+        };
+        if name.starts_with('.') || name == "target" {
+            continue;
+        }
+        if e.file_type().is_ok_and(|t| t.is_dir()) {
+            markdown_files(&e.path(), &path, out);
+        } else if name.ends_with(".md") {
+            out.push(path);
+        }
+    }
+}
+
+#[test]
+fn every_relative_link_resolves() {
+    let mut docs = Vec::new();
+    markdown_files(&repo(), "", &mut docs);
+    docs.sort();
+    assert!(docs.iter().any(|d| d == "README.md"), "{docs:?}");
+    let bad: Vec<String> = docs
+        .iter()
+        .flat_map(|d| links::broken(&repo(), d))
+        .collect();
+    assert!(
+        bad.is_empty(),
+        "{} broken links:\n{}",
+        bad.len(),
+        bad.join("\n")
+    );
 }
 
 #[test]

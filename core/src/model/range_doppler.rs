@@ -415,7 +415,7 @@ impl GaussRun {
     fn next(&mut self) -> f32 {
         let g = self.g;
         self.k += 1;
-        if self.k % ANCHOR == 0 {
+        if self.k.is_multiple_of(ANCHOR) {
             self.anchor(self.u0 + self.k as f32 * self.d);
         } else {
             self.g *= self.q;
@@ -650,7 +650,7 @@ impl<'a> BlockMap<'a> {
             });
         }
         let block = block.max(1);
-        if g.n_velocity % block != 0 {
+        if !g.n_velocity.is_multiple_of(block) {
             return Err(Error::InvalidConfig(
                 "velocity_block must divide n_velocity",
             ));

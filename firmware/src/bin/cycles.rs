@@ -16,16 +16,12 @@
 //! target and for a register target (BX), SDIV/UDIV at the worst case 12.
 //!
 //! **Detector steps** (`step`): the same detector types, configurations, seeds and frames
-//! as the instruction table's modules (`src/crpf.rs`, `mht.rs`, `phd.rs`, `cbmember.rs`,
-//! `dp.rs`), with fewer frames where a frame costs tens of millions of instructions (the
+//! as the instruction table's modules (`src/rows/crpf.rs`, `mht.rs`, `phd.rs`,
+//! `cbmember.rs`, `dp.rs`), with fewer frames where a frame costs tens of millions of instructions (the
 //! trace runs at about 0.6 M translation blocks per second). Each step is also measured
 //! with the harness's timer: the tool fails if the traced and timed counts differ.
 #![no_std]
 #![no_main]
-
-#[path = "../harness.rs"]
-#[allow(dead_code)]
-mod harness;
 
 use core::arch::asm;
 use core::hint::black_box;
@@ -51,7 +47,12 @@ use faint_core::model::range_doppler::PointModel;
 use faint_core::rng::Rng;
 use faint_core::Complex32;
 
-use harness::{check, measure, Static, Text};
+use faint_firmware::harness::{self, check, measure};
+use faint_firmware::semihosting::exit_success;
+use faint_firmware::statics::{only_ref, Static};
+use faint_firmware::text::Text;
+
+faint_firmware::report_panics!();
 
 /// Start of a traced region (the tool finds it by name in the trace).
 #[no_mangle]
@@ -317,22 +318,13 @@ fn micros() {
 
 // ---- detector steps ----------------------------------------------------------------
 
-/// The `&mut` to a static.
-///
-/// # Safety
-/// `p` points to a static that nothing else references while the result lives.
-unsafe fn only_ref<T>(p: *mut T) -> &'static mut T {
-    // SAFETY: the caller's contract.
-    unsafe { &mut *p }
-}
-
 static mut CRPF_1000: CrpfTbd1000 = CrpfTbd1000::new_unconfigured();
 static mut PF_1000: PfTbd1000 = PfTbd1000::new_unconfigured();
 static mut JOTT_1000: JottTbd1000 = JottTbd1000::new_unconfigured();
 static mut LRT_1000: PfLrt1000 = PfLrt1000::new_unconfigured();
 static mut CRPF_6000: CrpfTbd6000 = CrpfTbd6000::new_unconfigured();
 
-/// `src/crpf.rs`'s single-frame row: 6 warm-up frames, then frame 7 measured.
+/// `src/rows/crpf.rs`'s single-frame row: 6 warm-up frames, then frame 7 measured.
 fn crpf_one(
     label: &str,
     step_fn: &mut dyn FnMut(&[Complex32]) -> faint_core::Result<DopplerReport>,
@@ -395,7 +387,7 @@ type Mht = MhtTbdM4;
 static MHT: Static<Mht> = Static::new(Mht::new_unconfigured());
 static SCAN: Static<[Plot; 512]> = Static::new([Plot::new(0.0, 0.0, 0.0); 512]);
 
-/// `src/mht.rs`: 29 censoring scans (scan 2 traced), then the period end (traced).
+/// `src/rows/mht.rs`: 29 censoring scans (scan 2 traced), then the period end (traced).
 fn mht() {
     let det = MHT.take();
     let buf = SCAN.take();
@@ -426,7 +418,7 @@ const PHD_CELLS: usize = faint_golden::phd::FIRMWARE_WINDOW.len();
 static mut PHD: Phd = Phd::new_unconfigured();
 static CUBE: Static<[f32; PHD_CELLS]> = Static::new([0.0; PHD_CELLS]);
 
-/// `src/phd.rs`: PHD-TBD frames 0-1 and PSO-PHD-TBD (K-means) frames 0-1 (frame 1 is the
+/// `src/rows/phd.rs`: PHD-TBD frames 0-1 and PSO-PHD-TBD (K-means) frames 0-1 (frame 1 is the
 /// first with the swarm), each frame traced.
 fn phd() {
     use faint_golden::phd::{config, cube, ALGORITHMS, FIRMWARE_WINDOW};
@@ -455,7 +447,7 @@ type Cbm = CbmemberTbdM4;
 static mut CBM: Cbm = Cbm::new_unconfigured();
 static MAP: Static<[f32; 256 * 512]> = Static::new([0.0; 256 * 512]);
 
-/// `src/cbmember.rs`: joint model at 1000 particles, frames 0-1 (frame 1 traced).
+/// `src/rows/cbmember.rs`: joint model at 1000 particles, frames 0-1 (frame 1 traced).
 fn cbmember() {
     use faint_golden::cbmember::{config, map};
     const SEED: u64 = 0x0003_CB3E_3BE7_2023;
@@ -495,7 +487,7 @@ const _: A9 = unsafe { MaybeUninit::zeroed().assume_init() };
 const _: P9 = unsafe { MaybeUninit::zeroed().assume_init() };
 const _: S9 = unsafe { MaybeUninit::zeroed().assume_init() };
 
-/// `src/dp.rs`: frames 1..=`last` from `configure`, frames 3..=`last` traced.
+/// `src/rows/dp.rs`: frames 1..=`last` from `configure`, frames 3..=`last` traced.
 fn dp_rows<D: DpTrack>(name: &str, det: &mut D, cfg: DpConfig, last: usize) {
     use faint_golden::dp::{frame, SIGMA};
     const SEED: u64 = 0x0004_D9B8_CDB8_7468;
@@ -570,5 +562,5 @@ fn main() -> ! {
     cbmember();
     phd();
     hprintln!("done");
-    harness::exit_success()
+    exit_success()
 }

@@ -15,9 +15,7 @@
 #![no_std]
 #![no_main]
 
-#[path = "../panic_never_common.rs"]
-#[macro_use]
-mod common;
+faint_firmware::panic_never!();
 
 use core::hint::black_box;
 
@@ -26,13 +24,15 @@ use faint_core::detect::cbmember::{CbmemberConfig, CbmemberTbd, Likelihood};
 use faint_core::detect::Detector;
 use faint_core::existence::ExistenceMarkov;
 use faint_core::math;
-use faint_core::model::range_doppler::{PointModel, RdGeometry};
+use faint_core::model::range_doppler::PointModel;
 use faint_core::particles::{self, Scheme};
 use faint_core::rng::Rng;
+use faint_firmware::semihosting::finish;
+use faint_golden::cbmember::GOLDEN_WINDOW;
 
 const N: usize = 1000;
 
-/// CBMeMBer TBD on a 32 x 128 map (16-bin blocks: 256 block sums).
+/// CBMeMBer TBD on the golden case's 32 x 128 map (16-bin blocks: 256 block sums).
 type Cbm = CbmemberTbd<2, 64, 256>;
 type CbmU8 = CbmemberTbd<2, 64, 256, [u8]>;
 static mut CBM: Cbm = Cbm::new_unconfigured();
@@ -42,7 +42,7 @@ static mut MAP_U8: [u8; 32 * 128] = [0; 32 * 128];
 
 #[entry]
 fn main() -> ! {
-    common::finish(
+    finish(
         run(),
         b"panic-never: primitives and CbmemberTbd linked without a panic path and ran ok\n",
         b"panic-never: a primitive returned Err\n",
@@ -127,14 +127,7 @@ fn cbmember(rng: &mut Rng) -> bool {
         )
     };
     let mut cfg = CbmemberConfig::rotor_uav();
-    cfg.geometry = RdGeometry {
-        n_range: 32,
-        n_velocity: 128,
-        range_start: 19_997.5,
-        range_bin: 0.781_25,
-        velocity_start: -4.0,
-        velocity_bin: 0.078_125,
-    };
+    cfg.geometry = GOLDEN_WINDOW;
     cfg.max_particles = 64;
     cfg.min_particles = 16;
     cfg.birth.particles = 32;

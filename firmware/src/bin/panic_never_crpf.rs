@@ -20,9 +20,7 @@
 #![no_std]
 #![no_main]
 
-#[path = "../panic_never_common.rs"]
-#[macro_use]
-mod common;
+faint_firmware::panic_never!();
 
 use core::hint::black_box;
 
@@ -38,6 +36,8 @@ use faint_core::model::doppler::{
 };
 use faint_core::rng::Rng;
 use faint_core::Complex32;
+use faint_firmware::semihosting::finish;
+use faint_firmware::statics::only_ref;
 
 /// Bins per frame of the preset.
 const M: usize = 32;
@@ -61,7 +61,7 @@ static mut CACHE: ProjectionCache = ProjectionCache::new();
 
 #[entry]
 fn main() -> ! {
-    common::finish(
+    finish(
         run(),
         b"panic-never-crpf: CRPF-TBD, PF-TBD, JOTT and PF-LRT linked without a panic path and ran ok\n",
         b"panic-never-crpf: a call did not return the expected Ok or Err\n",
@@ -76,24 +76,24 @@ fn run() -> bool {
     // to its static.
     unsafe {
         ok &= family::<64>(
-            common::only_ref(&raw mut CRPF_64),
-            common::only_ref(&raw mut PF_64),
-            common::only_ref(&raw mut JOTT_64),
-            common::only_ref(&raw mut LRT_64),
+            only_ref(&raw mut CRPF_64),
+            only_ref(&raw mut PF_64),
+            only_ref(&raw mut JOTT_64),
+            only_ref(&raw mut LRT_64),
             &mut rng,
         );
         ok &= family::<1000>(
-            common::only_ref(&raw mut CRPF_1000),
-            common::only_ref(&raw mut PF_1000),
-            common::only_ref(&raw mut JOTT_1000),
-            common::only_ref(&raw mut LRT_1000),
+            only_ref(&raw mut CRPF_1000),
+            only_ref(&raw mut PF_1000),
+            only_ref(&raw mut JOTT_1000),
+            only_ref(&raw mut LRT_1000),
             &mut rng,
         );
         ok &= family::<6000>(
-            common::only_ref(&raw mut CRPF_6000),
-            common::only_ref(&raw mut PF_6000),
-            common::only_ref(&raw mut JOTT_6000),
-            common::only_ref(&raw mut LRT_6000),
+            only_ref(&raw mut CRPF_6000),
+            only_ref(&raw mut PF_6000),
+            only_ref(&raw mut JOTT_6000),
+            only_ref(&raw mut LRT_6000),
             &mut rng,
         );
     }
@@ -471,7 +471,7 @@ fn model_functions(rng: &mut Rng) -> bool {
     acc += w.iter().map(|c| c.re + c.im).sum::<f32>();
 
     // SAFETY: single-threaded, the only reference to this static.
-    let cache = unsafe { common::only_ref(&raw mut CACHE) };
+    let cache = unsafe { only_ref(&raw mut CACHE) };
     let sizes = black_box([SPAN, 7, 31, M, 33, MAX_BINS, SPAN - 1, MAX_BINS + 1]);
     let windows = black_box([Window::Hamming, Window::Rectangular, Window::Hann]);
     for (i, &bins) in sizes.iter().enumerate() {

@@ -16,9 +16,7 @@
 #![no_std]
 #![no_main]
 
-#[path = "../panic_never_common.rs"]
-#[macro_use]
-mod common;
+faint_firmware::panic_never!();
 
 use core::hint::black_box;
 
@@ -29,6 +27,7 @@ use faint_core::detect::dp::{
 };
 use faint_core::detect::Detector;
 use faint_core::rng::Rng;
+use faint_firmware::semihosting::finish;
 
 const M: usize = 16;
 const L: usize = 5;
@@ -51,7 +50,7 @@ static mut S25_DET: S25 = S25::unconfigured();
 
 #[entry]
 fn main() -> ! {
-    common::finish(
+    finish(
         run(),
         b"panic-never-dp: DP-TBD detectors linked without a panic path and ran ok\n",
         b"panic-never-dp: a call did not return the expected Ok or Err\n",

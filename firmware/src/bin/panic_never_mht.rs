@@ -5,9 +5,9 @@
 //! than the capacity, empty scans), `redetect`, `set_gamma1`, the detections and every
 //! other public query of `MhtTbd` and `ClassicHough`, and the public Hough helpers
 //! (`Geometry`, `Accumulator`, `Censor::step`, `dmht::recover`) with arguments out of
-//! their documented ranges, at the firmware's `MhtTbd<512, 30, 256, 180, 16>`, the
-//! golden case's `MhtTbd<48, 10, 32, 30, 4>`, and `ClassicHough<256, 180, 64>` and
-//! `<32, 30, 4>`, on inputs hidden from the optimiser. As in `panic_never.rs`, the panic
+//! their documented ranges, at the firmware's `MhtTbdM4`, the
+//! golden case's `MhtTbdSmall`, and `ClassicHoughHost` and
+//! `ClassicHoughSmall`, on inputs hidden from the optimiser. As in `panic_never.rs`, the panic
 //! handler calls a function that does not exist, so the fat-LTO link fails with an
 //! undefined reference to `faint_core_panic_path_survived` if any panic path survives:
 //!
@@ -20,9 +20,7 @@
 #![no_std]
 #![no_main]
 
-#[path = "../panic_never_common.rs"]
-#[macro_use]
-mod common;
+faint_firmware::panic_never!();
 
 use core::hint::black_box;
 
@@ -37,8 +35,10 @@ use faint_core::detect::{Detector, Validate};
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
 use faint_core::scene;
+use faint_firmware::semihosting::finish;
+use faint_firmware::statics::only_ref;
 
-/// The firmware's shape (`firmware/src/mht.rs`).
+/// The firmware's shape (`firmware/src/rows/mht.rs`).
 type Big = MhtTbdM4;
 /// The golden case's shape (`golden/src/mht.rs`).
 type Small = MhtTbdSmall;
@@ -59,7 +59,7 @@ static mut PLOTS: [Plot; BUF] = [Plot::new(0.0, 0.0, 0.0); BUF];
 
 #[entry]
 fn main() -> ! {
-    common::finish(
+    finish(
         run(),
         b"panic-never-mht: MHT-TBD and the classic Hough TBD linked without a panic path and ran ok\n",
         b"panic-never-mht: a call did not return the expected Ok or Err\n",
@@ -73,14 +73,14 @@ fn run() -> bool {
     // to its static.
     let (big, small, cbig, csmall, acc, censor, flags, buf) = unsafe {
         (
-            common::only_ref(&raw mut BIG),
-            common::only_ref(&raw mut SMALL),
-            common::only_ref(&raw mut CLASSIC_BIG),
-            common::only_ref(&raw mut CLASSIC_SMALL),
-            common::only_ref(&raw mut ACC),
-            common::only_ref(&raw mut CENSOR),
-            common::only_ref(&raw mut FLAGS),
-            common::only_ref(&raw mut PLOTS),
+            only_ref(&raw mut BIG),
+            only_ref(&raw mut SMALL),
+            only_ref(&raw mut CLASSIC_BIG),
+            only_ref(&raw mut CLASSIC_SMALL),
+            only_ref(&raw mut ACC),
+            only_ref(&raw mut CENSOR),
+            only_ref(&raw mut FLAGS),
+            only_ref(&raw mut PLOTS),
         )
     };
     ok &= mht(big, &mut rng, buf);

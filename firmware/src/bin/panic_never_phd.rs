@@ -4,7 +4,7 @@
 //! infinite, negative, short and long frames), the detections and every other public
 //! query of `SmcPhdTbd`, with Gaussian and measurement-driven births, the swarm with and
 //! without point refinement, single-cell and merged-cell normalisation, and rejected
-//! configurations, at the firmware's `SmcPhdTbd<6144, 1024, 8, 8>`, the golden case's
+//! configurations, at the firmware's `SmcPhdTbdM4`, the golden case's
 //! `SmcPhdTbd<256, 256, 4, 4>` and a one-target, one-point `SmcPhdTbd<64, 16, 1, 1>`;
 //! plus the public building blocks (`Swarm`, `non_dominated_sort`, `crowding_distance`,
 //! `ndsort::rank_sorted`, `Dbscan`, `KMeans`) with workspaces shorter than their inputs,
@@ -21,9 +21,7 @@
 #![no_std]
 #![no_main]
 
-#[path = "../panic_never_common.rs"]
-#[macro_use]
-mod common;
+faint_firmware::panic_never!();
 
 use core::hint::black_box;
 
@@ -37,9 +35,11 @@ use faint_core::detect::phd::{BirthMode, SmcPhdTbd, SmcPhdTbdM4, SmcPhdTbdSmall}
 use faint_core::detect::Detector;
 use faint_core::model::power_cube::CubeGeometry;
 use faint_core::rng::Rng;
+use faint_firmware::semihosting::finish;
+use faint_firmware::statics::only_ref;
 use faint_golden::phd::{config, cube, ALGORITHMS, FIRMWARE_WINDOW, GOLDEN_WINDOW};
 
-/// The firmware's shape (`firmware/src/phd.rs`).
+/// The firmware's shape (`firmware/src/rows/phd.rs`).
 type Big = SmcPhdTbdM4;
 /// The golden case's shape (`golden/src/phd.rs`).
 type Small = SmcPhdTbdSmall;
@@ -59,7 +59,7 @@ static mut CUBE: [f32; CELLS] = [0.0; CELLS];
 
 #[entry]
 fn main() -> ! {
-    common::finish(
+    finish(
         run(),
         b"panic-never-phd: PHD-TBD, PSO-PHD-TBD (K-means) and PSO-PHD-TBD (DBSCAN) linked without a panic path and ran ok\n",
         b"panic-never-phd: a call did not return the expected Ok or Err\n",
@@ -73,13 +73,13 @@ fn run() -> bool {
     // to its static.
     let (big, small, tiny, swarm, dbscan, kmeans, buf) = unsafe {
         (
-            common::only_ref(&raw mut BIG),
-            common::only_ref(&raw mut SMALL),
-            common::only_ref(&raw mut TINY),
-            common::only_ref(&raw mut SWARM),
-            common::only_ref(&raw mut DBSCAN),
-            common::only_ref(&raw mut KMEANS),
-            common::only_ref(&raw mut CUBE),
+            only_ref(&raw mut BIG),
+            only_ref(&raw mut SMALL),
+            only_ref(&raw mut TINY),
+            only_ref(&raw mut SWARM),
+            only_ref(&raw mut DBSCAN),
+            only_ref(&raw mut KMEANS),
+            only_ref(&raw mut CUBE),
         )
     };
     // The firmware's shape and counts on its window: two scene frames per variant (the

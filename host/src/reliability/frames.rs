@@ -2,13 +2,15 @@
 //!
 //! Each frame is drawn in one [`Mode`]; most are plausible (noise at the preset's level,
 //! sometimes with a strong return), the rest carry arbitrary bits, extremes, a constant,
-//! a single NaN/inf, or the wrong length.
+//! a single NaN/inf, or the wrong length. The plausible values and scans are
+//! `faint_golden::soak`'s, the generator the firmware's soak draws its frames with.
 
 use faint_core::detect::cbmember::CbmemberConfig;
 use faint_core::detect::phd::PhdConfig;
 use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
 use faint_core::Complex32;
+use faint_golden::soak::{plausible as one_plausible, plot_count, plot_inside};
 
 /// How a frame is drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -81,15 +83,7 @@ pub const BAD: [f32; 3] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY];
 /// `len` reals in `mode`; `scale` is the preset's noise level, `positive` makes the
 /// plausible values powers (`|x|^2`) rather than signed amplitudes.
 pub fn reals(rng: &mut Rng, len: usize, mode: Mode, scale: f32, positive: bool) -> Vec<f32> {
-    let plausible = |rng: &mut Rng, s: f32| -> f32 {
-        let x = rng.normal() * s;
-        let strong = if rng.below(8) == 0 { 10.0 * s } else { 0.0 };
-        if positive {
-            x * x + strong * strong
-        } else {
-            x + strong
-        }
-    };
+    let plausible = |rng: &mut Rng, s: f32| one_plausible(rng, s, positive);
     match mode {
         Mode::Plausible => (0..len).map(|_| plausible(rng, scale)).collect(),
         Mode::Scaled => {
@@ -143,18 +137,8 @@ pub fn complex(rng: &mut Rng, len: usize, mode: Mode, scale: f32) -> Vec<Complex
 /// A scan of plots in `mode`, inside `area = [x0, x1, y0, y1]` when plausible; the count
 /// runs from 0 to twice `capacity` (over-capacity lists are expected input).
 pub fn plots(rng: &mut Rng, area: [f32; 4], capacity: usize, mode: Mode) -> Vec<Plot> {
-    let n = match rng.below(8) {
-        0 => 0,
-        1 => capacity + 1 + rng.below(capacity as u32 + 1) as usize,
-        _ => rng.below(capacity.min(64) as u32 + 1) as usize,
-    };
-    let inside = |rng: &mut Rng| {
-        Plot::new(
-            1.0 + rng.exponential(),
-            rng.uniform_range(area[0].min(area[1]), area[1].max(area[0])),
-            rng.uniform_range(area[2].min(area[3]), area[3].max(area[2])),
-        )
-    };
+    let n = plot_count(rng, capacity);
+    let inside = |rng: &mut Rng| plot_inside(rng, area);
     match mode {
         Mode::Plausible | Mode::Constant | Mode::WrongLength => {
             (0..n).map(|_| inside(rng)).collect()

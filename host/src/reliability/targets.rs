@@ -20,6 +20,9 @@ use faint_core::detect::phd::PhdConfig;
 use faint_core::detect::Detector;
 use faint_core::model::range_doppler::PointModel;
 use faint_core::rng::Rng;
+use faint_golden::soak::{
+    cbmember_reduced, cube_cells, CLASSIC_PLOTS, DP_REDUCED_SIDE, DP_SCALE, PHD_REDUCED_CELLS,
+};
 use serde::Serialize;
 use serde_json::Value;
 
@@ -67,7 +70,7 @@ fn scan_classic(
     c: &faint_core::detect::mht::ClassicHoughConfig,
     mode: Mode,
 ) -> Vec<faint_core::model::plot::Plot> {
-    plots(rng, c.area, 64, mode)
+    plots(rng, c.area, CLASSIC_PLOTS, mode)
 }
 
 fn cube(rng: &mut Rng, c: &PhdConfig, mode: Mode) -> Vec<f32> {
@@ -79,44 +82,22 @@ fn map(rng: &mut Rng, c: &CbmemberConfig, mode: Mode) -> Vec<f32> {
 }
 
 fn image(rng: &mut Rng, _c: &DpConfig, mode: Mode) -> Vec<f32> {
-    reals(rng, SIDE * SIDE, mode, 1.5, false)
+    reals(rng, SIDE * SIDE, mode, DP_SCALE, false)
 }
 
 /// The PSO-PHD-TBD preset on a 30 x 30 x 20 cube over the same extent.
 pub fn small_phd(v: Variant) -> PhdConfig {
     let mut c = SixTargets::new(9.0).config(v);
-    let g = &mut c.geometry;
-    let (r, d, a) = (
-        g.range_cell * g.n_range as f32,
-        g.doppler_cell * g.n_doppler as f32,
-        g.azimuth_cell_deg * g.n_azimuth as f32,
-    );
-    g.n_range = 30;
-    g.n_doppler = 30;
-    g.n_azimuth = 20;
-    g.range_cell = r / 30.0;
-    g.doppler_cell = d / 30.0;
-    g.azimuth_cell_deg = a / 20.0;
+    c.geometry = cube_cells(c.geometry, [30, 30, 20]);
     c
 }
 
 /// [`Shape::Reduced`]'s PHD-TBD / PSO-PHD-TBD: an 8 x 8 x 4 cube over the preset's
-/// extent, 50 particles per target, 25 births (and at least 25 particles), at most 32
-/// particles in the swarm.
+/// extent ([`PHD_REDUCED_CELLS`]), 50 particles per target, 25 births (and at least 25
+/// particles), at most 32 particles in the swarm.
 pub fn reduced_phd(v: Variant) -> PhdConfig {
     let mut c = SixTargets::new(9.0).config(v);
-    let g = &mut c.geometry;
-    let (r, d, a) = (
-        g.range_cell * g.n_range as f32,
-        g.doppler_cell * g.n_doppler as f32,
-        g.azimuth_cell_deg * g.n_azimuth as f32,
-    );
-    g.n_range = 8;
-    g.n_doppler = 8;
-    g.n_azimuth = 4;
-    g.range_cell = r / 8.0;
-    g.doppler_cell = d / 8.0;
-    g.azimuth_cell_deg = a / 4.0;
+    c.geometry = cube_cells(c.geometry, PHD_REDUCED_CELLS);
     c.particles_per_target = 50;
     c.birth.particles = 25;
     c.min_particles = 25;
@@ -127,27 +108,20 @@ pub fn reduced_phd(v: Variant) -> PhdConfig {
 }
 
 /// The CBMeMBer preset (`model`), and in [`Shape::Reduced`] on a 32 x 64 map over the
-/// preset's extent with `L_max = 100`, `L_min = 30` and 30 birth particles.
+/// preset's extent with `L_max = 100`, `L_min = 30` and 30 birth particles
+/// ([`cbmember_reduced`], the firmware soak's configuration).
 pub fn cbmember_config(model: PointModel, shape: Shape) -> CbmemberConfig {
-    let mut c = CbmemberConfig {
-        model,
-        ..CbmemberConfig::rotor_uav()
-    };
-    if shape == Shape::Reduced {
-        let g = &mut c.geometry;
-        g.range_bin *= g.n_range as f32 / 32.0;
-        g.velocity_bin *= g.n_velocity as f32 / 64.0;
-        g.n_range = 32;
-        g.n_velocity = 64;
-        c.max_particles = 100;
-        c.min_particles = 30;
-        c.birth.particles = 30;
+    match shape {
+        Shape::Reduced => cbmember_reduced(model),
+        Shape::Preset => CbmemberConfig {
+            model,
+            ..CbmemberConfig::rotor_uav()
+        },
     }
-    c
 }
 
 /// Side of [`Shape::Reduced`]'s DP-TBD images.
-pub const REDUCED_SIDE: usize = 32;
+pub const REDUCED_SIDE: usize = DP_REDUCED_SIDE;
 
 type Arnold32 =
     ArnoldDp<REDUCED_SIDE, 9, { sdp::HISTORY }, { arnold_words(REDUCED_SIDE, 9, sdp::HISTORY) }>;
@@ -169,7 +143,7 @@ unsafe impl sdp::ZeroValid for Pulford32 {}
 unsafe impl sdp::ZeroValid for Second32 {}
 
 fn image_reduced(rng: &mut Rng, _c: &DpConfig, mode: Mode) -> Vec<f32> {
-    reals(rng, REDUCED_SIDE * REDUCED_SIDE, mode, 1.5, false)
+    reals(rng, REDUCED_SIDE * REDUCED_SIDE, mode, DP_SCALE, false)
 }
 
 /// Two detectors configured with `cfg` (seed 0), on the heap.
@@ -342,4 +316,136 @@ pub fn run(name: &str, job: Job) -> Result<Outcome> {
             other => bail!("unknown detector '{other}'"),
         })
     })
+}
+
+#[cfg(test)]
+mod tests {
+    //! The firmware's soak (`firmware/src/bin/soak.rs`) streams its detectors the frames
+    //! of `faint_golden::soak` with that module's sizes and seed; the host's soak draws
+    //! them through this file's generators from its own configurations and instance
+    //! sizes. These tests check that both draw the same frames bit for bit, i.e. that
+    //! the target soaks what the host soaks.
+    use super::*;
+    use faint_core::model::plot::Plot;
+    use faint_core::Complex32;
+    use faint_golden::soak as fw;
+
+    /// Frames compared per detector: every branch of the scan-count law (one in 8) and
+    /// the strong-return draw (one value in 8) occur many times in 40 frames.
+    const FRAMES: usize = 40;
+
+    /// Draws `FRAMES` frames with the host's `host` and the firmware's `target` from one
+    /// seed each and compares their bits.
+    fn same<T: Copy + Default, const B: usize>(
+        name: &str,
+        host: impl Fn(&mut Rng) -> Vec<T>,
+        target: impl Fn(&mut Rng, &mut [T]) -> usize,
+        bits: impl Fn(&T) -> [u32; 3],
+    ) {
+        let (mut h, mut t) = (Rng::seed_from_u64(fw::SEED), Rng::seed_from_u64(fw::SEED));
+        let mut buf = vec![T::default(); B];
+        for k in 0..FRAMES {
+            let a = host(&mut h);
+            let n = target(&mut t, &mut buf);
+            let (a, b): (Vec<_>, Vec<_>) = (
+                a.iter().map(&bits).collect(),
+                buf[..n].iter().map(&bits).collect(),
+            );
+            assert_eq!(a, b, "{name}: frame {k} differs between host and firmware");
+        }
+    }
+
+    fn real(x: &f32) -> [u32; 3] {
+        [x.to_bits(), 0, 0]
+    }
+
+    fn bin(z: &Complex32) -> [u32; 3] {
+        [z.re.to_bits(), z.im.to_bits(), 0]
+    }
+
+    fn plot(p: &Plot) -> [u32; 3] {
+        [p.amplitude.to_bits(), p.x.to_bits(), p.y.to_bits()]
+    }
+
+    #[test]
+    fn doppler_frames_are_the_firmware_soaks() {
+        let crpf = CrpfConfig::othr();
+        let gauss = GaussConfig::othr(1.0);
+        let target = |r: &mut Rng, o: &mut [Complex32]| fw::complex(r, o, 1.0);
+        same::<_, { fw::DOPPLER_BINS }>(
+            "crpf",
+            |r| doppler_crpf(r, &crpf, Mode::Plausible),
+            target,
+            bin,
+        );
+        same::<_, { fw::DOPPLER_BINS }>(
+            "pf-tbd, jott, pf-lrt",
+            |r| doppler_gauss(r, &gauss, Mode::Plausible),
+            target,
+            bin,
+        );
+    }
+
+    #[test]
+    fn scans_are_the_firmware_soaks() {
+        let mht = MhtConfig::sea_clutter();
+        same::<_, { 2 * fw::MHT_PLOTS + 1 }>(
+            "mht",
+            |r| scan_mht(r, &mht, Mode::Plausible),
+            |r, o| fw::plots(r, mht.area, fw::MHT_PLOTS, o),
+            plot,
+        );
+        // The firmware cannot compute the classic threshold (the host's binomial strip
+        // model): it carries the value, which must be the host's.
+        let classic = default_classic();
+        assert_eq!(
+            (classic.area, classic.n_scans, classic.gamma),
+            (fw::CLASSIC.area, fw::CLASSIC.n_scans, fw::CLASSIC.gamma)
+        );
+        same::<_, { 2 * fw::CLASSIC_PLOTS + 1 }>(
+            "hough-classic",
+            |r| scan_classic(r, &classic, Mode::Plausible),
+            |r, o| fw::plots(r, fw::CLASSIC.area, fw::CLASSIC_PLOTS, o),
+            plot,
+        );
+    }
+
+    #[test]
+    fn reduced_frames_are_the_firmware_soaks() {
+        const CELLS: usize =
+            fw::PHD_REDUCED_CELLS[0] * fw::PHD_REDUCED_CELLS[1] * fw::PHD_REDUCED_CELLS[2];
+        for v in [Variant::PhdTbd, Variant::PsoKMeans, Variant::PsoDbscan] {
+            let c = reduced_phd(v);
+            same::<_, CELLS>(
+                "phd (reduced)",
+                |r| cube(r, &c, Mode::Plausible),
+                |r, o| fw::reals(r, o, 1.0, true),
+                real,
+            );
+        }
+        const PIXELS: usize = fw::CBMEMBER_REDUCED_PIXELS[0] * fw::CBMEMBER_REDUCED_PIXELS[1];
+        for model in [PointModel::Joint, PointModel::DopplerOnly] {
+            let c = cbmember_config(model, Shape::Reduced);
+            same::<_, PIXELS>(
+                "cbmember (reduced)",
+                |r| map(r, &c, Mode::Plausible),
+                |r, o| fw::reals(r, o, 1.0, true),
+                real,
+            );
+        }
+        let dp = DpConfig::dim_point(Method::Arnold, 1);
+        let target = |r: &mut Rng, o: &mut [f32]| fw::reals(r, o, fw::DP_SCALE, false);
+        same::<_, { fw::DP_SIDE * fw::DP_SIDE }>(
+            "dp-arnold",
+            |r| image(r, &dp, Mode::Plausible),
+            target,
+            real,
+        );
+        same::<_, { fw::DP_REDUCED_SIDE * fw::DP_REDUCED_SIDE }>(
+            "dp-pulford, dp-second (reduced)",
+            |r| image_reduced(r, &dp, Mode::Plausible),
+            target,
+            real,
+        );
+    }
 }

@@ -21,7 +21,9 @@ use faint_core::model::range_doppler::{quantise, Dequant, PointModel, PowerMap};
 use faint_core::rng::Rng;
 use faint_golden::cbmember::{config, map};
 
-use crate::harness::{check, measure, row, Measurement, Static, Text};
+use faint_firmware::harness::{check, measure, row, Measurement};
+use faint_firmware::statics::Static;
+use faint_firmware::text::Text;
 
 const SEED: u64 = 0x0003_CB3E_3BE7_2023;
 /// Frames per variant.

@@ -25,8 +25,9 @@ use faint_core::rng::Rng;
 use faint_core::Complex32;
 use faint_golden::crpf::{frame, target, BIN_VAR};
 
-use crate::harness::{check, measure, row, Measurement};
 use cortex_m_semihosting::hprintln;
+use faint_firmware::harness::{check, measure, row, Measurement};
+use faint_firmware::statics::only_ref;
 
 const SEED: u64 = 0x00C0_57F1_17E2_2017;
 
@@ -202,15 +203,6 @@ fn rows<const N: usize>(
         model,
         size_of::<PfLrt<N>>(),
     );
-}
-
-/// The `&mut` to a static detector.
-///
-/// # Safety
-/// `p` points to a static that nothing else references while the result lives.
-unsafe fn only_ref<T>(p: *mut T) -> &'static mut T {
-    // SAFETY: the caller's contract.
-    unsafe { &mut *p }
 }
 
 /// Prints the four detectors' rows at N = 1000 and N = 6000. Call once: it takes the

@@ -32,7 +32,8 @@ use faint_golden::dp::{frame, target, SIGMA};
 
 use core::sync::atomic::{AtomicBool, Ordering};
 
-use crate::harness::{check, measure, row, Measurement, Text};
+use faint_firmware::harness::{check, measure, row, Measurement};
+use faint_firmware::text::Text;
 
 const SEED: u64 = 0x0004_D9B8_CDB8_7468;
 const M: usize = 128;

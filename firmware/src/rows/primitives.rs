@@ -11,7 +11,8 @@ use faint_core::math;
 use faint_core::particles::{self, Scheme};
 use faint_core::rng::Rng;
 
-use crate::harness::{check, measure, row, Static};
+use faint_firmware::harness::{check, measure, row};
+use faint_firmware::statics::Static;
 
 const SEED: u64 = 0x00FA_1A7F_0F1E_7A11;
 

@@ -11,11 +11,10 @@
 //! all-zero, set up in place) and the cube window are the static RAM of the rows. The
 //! swarm runs the paper's `gen = 10` generations before its stop test, so PSO frames run
 //! past the harness timer's 167.8 M-instruction wrap: every `step` here is measured with
-//! [`measure_long`], which counts the wraps with the board's dual timer.
+//! `harness::measure_long`, which counts the wraps with the board's dual timer.
 
 use core::hint::black_box;
 use core::mem::size_of;
-use core::ptr::{read_volatile, write_volatile};
 use faint_core::detect::Detector;
 
 use cortex_m_semihosting::hprintln;
@@ -23,7 +22,10 @@ use faint_core::detect::phd::{PhdConfig, SmcPhdTbdM4};
 use faint_core::rng::Rng;
 use faint_golden::phd::{config, cube, ALGORITHMS, FIRMWARE_WINDOW, FRAMES};
 
-use crate::harness::{check, measure, row, Measurement, Static};
+use faint_firmware::harness::{check, measure_long, row, Measurement};
+use faint_firmware::statics::Static;
+use faint_firmware::text::Text;
+use faint_firmware::timer::coarse_start;
 
 const SEED: u64 = 0x0002_0019_9E1D_7BD0;
 /// Particles per estimated target and birth particles (the preset's).
@@ -109,54 +111,8 @@ fn variant(det: &mut Det, buf: &mut [f32; CELLS], name: &str, cfg: PhdConfig, fr
     );
 }
 
-/// Timer 1 of the CMSDK dual timer (SP804-like) of the MPS2 board: load, value, control.
-const DUAL_LOAD: *mut u32 = 0x4000_2000 as *mut u32;
-const DUAL_VALUE: *mut u32 = 0x4000_2004 as *mut u32;
-const DUAL_CONTROL: *mut u32 = 0x4000_2008 as *mut u32;
-/// Instructions per wrap of the harness's timer0: `2^32` ticks at 25.6 ticks each.
-const WRAP: u64 = (1 << 32) * 10 / 256;
-
-/// Starts the dual timer's first counter as a free-running 32-bit down-counter with the
-/// /256 prescaler (control: enable, 32-bit, prescale 256, no interrupt): 0.1 tick per
-/// instruction, so it wraps only after 4.3e10 instructions.
-fn coarse_start() {
-    // SAFETY: the dual timer's registers on the MPS2 memory map; nothing else uses it.
-    unsafe {
-        write_volatile(DUAL_CONTROL, 0);
-        write_volatile(DUAL_LOAD, u32::MAX);
-        write_volatile(DUAL_CONTROL, 0x80 | (2 << 2) | 0x02);
-    }
-}
-
-fn coarse() -> u32 {
-    // SAFETY: read of a device register.
-    unsafe { read_volatile(DUAL_VALUE) }
-}
-
-/// [`measure`] for calls longer than the harness timer's wrap (167.8 M instructions, which
-/// the 10-generation swarm frames reach): the coarse timer (10 instructions per tick)
-/// read around the measurement gives the number of wraps, the fine count the rest.
-fn measure_long<R>(f: impl FnOnce() -> R) -> (R, Measurement) {
-    let c0 = coarse();
-    let (r, mut m) = measure(f);
-    let c1 = coarse();
-    let approx = u64::from(c0.wrapping_sub(c1)) * 10;
-    let fine = m.instructions;
-    let wraps = (approx + WRAP / 2).saturating_sub(fine) / WRAP;
-    let total = fine + wraps * WRAP;
-    // Self-check: the corrected count agrees with the coarse one to its resolution (plus
-    // painting and scanning the 64 KiB stack window, ~150 k), else the dual timer is not
-    // what we assume.
-    assert!(
-        total.abs_diff(approx) <= 250_000 + approx / 1000,
-        "coarse timer check failed: fine {fine}, coarse {approx}"
-    );
-    m.instructions = total;
-    (r, m)
-}
-
 fn hprintln_row(name: &str, what: &str, frames: usize, n: u32, m: Measurement) {
-    let mut label = crate::harness::Text::<128>::new();
+    let mut label = Text::<128>::new();
     let _ = core::fmt::Write::write_fmt(
         &mut label,
         format_args!("{name} step, {what} 0-{} (32^3 cells)", frames - 1),

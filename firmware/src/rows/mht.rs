@@ -13,7 +13,8 @@ use faint_core::model::plot::Plot;
 use faint_core::rng::Rng;
 use faint_golden::mht::{cost_scan, COST_SEED};
 
-use crate::harness::{check, measure, row, Measurement, Static};
+use faint_firmware::harness::{check, measure, row, Measurement};
+use faint_firmware::statics::Static;
 
 const P: usize = 512;
 
