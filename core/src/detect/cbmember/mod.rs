@@ -552,8 +552,55 @@ impl<
         F: ?Sized + PowerMap,
     > CbmemberTbd<COMPONENTS, PARTICLES, BLOCK_SUMS, F>
 {
-    /// Checks `cfg` against the capacities (`C, P >= 1`, `P <= 65 536`, `L_max <= P`,
-    /// birth particles `<= P`, block sums `<= S`).
+    /// The unconfigured filter (a compile-time constant, [`Detector::UNCONFIGURED`]):
+    /// every call but [`Detector::configure`] returns a typed error or nothing until a
+    /// configuration succeeds. For a `static` or a `Box`.
+    pub const fn new_unconfigured() -> Self {
+        <Self as Detector>::UNCONFIGURED
+    }
+
+    /// A configured filter built by value (small capacities; use
+    /// [`new_unconfigured`](Self::new_unconfigured) in a `Box` or a `static` with
+    /// [`Detector::configure`] for large ones).
+    pub fn new(cfg: CbmemberConfig, seed: u64) -> Result<Self> {
+        Self::check(&cfg)?;
+        let comp = Component {
+            live: false,
+            r: 0.0,
+            n: 0,
+            id: 0,
+            age: 0,
+            est: [0.0; DIM],
+            x: [[0.0; DIM]; PARTICLES],
+            w: [0.0; PARTICLES],
+        };
+        let mut f = Self {
+            cfg,
+            comps: core::array::from_fn(|_| comp.clone()),
+            lw: [0.0; PARTICLES],
+            anc: [0; PARTICLES],
+            blocks: [0.0; BLOCK_SUMS],
+            h: [0.0; MAX_VELOCITY_BINS],
+            p: [0.0; 2 * MAX_VELOCITY_BINS],
+            kernel: Kernel::default(),
+            dq: Dequant::new(1.0, 1.0),
+            c0: 0.0,
+            rng: Rng::seed_from_u64(seed),
+            next_id: 1,
+            frames: 0,
+            reported: [0; COMPONENTS],
+            n_reported: 0,
+            birth_peak: 0.0,
+            has_peak: false,
+            _frame: PhantomData,
+        };
+        f.configure(&cfg, seed)?;
+        Ok(f)
+    }
+
+    /// Checks `cfg` against the capacities (`COMPONENTS, PARTICLES >= 1`,
+    /// `PARTICLES <= 65 536`, `L_max <= PARTICLES`, birth particles `<= PARTICLES`, block
+    /// sums `<= BLOCK_SUMS`).
     fn check(cfg: &CbmemberConfig) -> Result<()> {
         cfg.validate()?;
         if COMPONENTS == 0 || PARTICLES == 0 || COMPONENTS > u16::MAX as usize {
@@ -1055,59 +1102,5 @@ impl<
                 len: e.age,
             }),
         ))
-    }
-}
-
-impl<
-        const COMPONENTS: usize,
-        const PARTICLES: usize,
-        const BLOCK_SUMS: usize,
-        F: ?Sized + PowerMap,
-    > CbmemberTbd<COMPONENTS, PARTICLES, BLOCK_SUMS, F>
-{
-    /// The unconfigured filter (a compile-time constant, [`Detector::UNCONFIGURED`]):
-    /// every call but [`Detector::configure`] returns a typed error or nothing until a
-    /// configuration succeeds. For a `static` or a `Box`.
-    pub const fn new_unconfigured() -> Self {
-        <Self as Detector>::UNCONFIGURED
-    }
-
-    /// A configured filter built by value (small capacities; use
-    /// [`new_unconfigured`](Self::new_unconfigured) in a `Box` or a `static` with
-    /// [`Detector::configure`] for large ones).
-    pub fn new(cfg: CbmemberConfig, seed: u64) -> Result<Self> {
-        Self::check(&cfg)?;
-        let comp = Component {
-            live: false,
-            r: 0.0,
-            n: 0,
-            id: 0,
-            age: 0,
-            est: [0.0; DIM],
-            x: [[0.0; DIM]; PARTICLES],
-            w: [0.0; PARTICLES],
-        };
-        let mut f = Self {
-            cfg,
-            comps: core::array::from_fn(|_| comp.clone()),
-            lw: [0.0; PARTICLES],
-            anc: [0; PARTICLES],
-            blocks: [0.0; BLOCK_SUMS],
-            h: [0.0; MAX_VELOCITY_BINS],
-            p: [0.0; 2 * MAX_VELOCITY_BINS],
-            kernel: Kernel::default(),
-            dq: Dequant::new(1.0, 1.0),
-            c0: 0.0,
-            rng: Rng::seed_from_u64(seed),
-            next_id: 1,
-            frames: 0,
-            reported: [0; COMPONENTS],
-            n_reported: 0,
-            birth_peak: 0.0,
-            has_peak: false,
-            _frame: PhantomData,
-        };
-        f.configure(&cfg, seed)?;
-        Ok(f)
     }
 }
