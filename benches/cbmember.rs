@@ -12,6 +12,7 @@ use faint::core::detect::cbmember::Likelihood;
 use faint::core::detect::Detector;
 use faint::core::model::range_doppler::{quantise, Dequant, PointModel};
 use faint::core::rng::Rng;
+use faint::host::instances::boxed;
 use faint::host::instances::cbmember::{HostFilter, HostFilterU8};
 use faint::host::simulate::cbmember::{MapSource, RotorUav};
 
@@ -44,7 +45,7 @@ fn bench_cbmember(c: &mut Criterion) {
     let mut g = c.benchmark_group("cbmember_frame");
     g.sample_size(30);
     for (name, model, particles) in ROWS {
-        let mut f = Box::new(HostFilter::new(sc.config(model, particles), 5).unwrap());
+        let mut f = boxed::<HostFilter>(&sc.config(model, particles), 5).unwrap();
         for m in &frames[..20] {
             f.step(m).unwrap();
         }
@@ -70,7 +71,7 @@ fn bench_cbmember(c: &mut Criterion) {
                 .collect()
         })
         .collect();
-    let mut f = Box::new(HostFilterU8::new(cfg, 5).unwrap());
+    let mut f = boxed::<HostFilterU8>(&cfg, 5).unwrap();
     for m in &q[..20] {
         f.step(m).unwrap();
     }
@@ -86,7 +87,7 @@ fn bench_cbmember(c: &mut Criterion) {
     });
     let mut ce = cfg;
     ce.likelihood = Likelihood::Exact;
-    let mut f = Box::new(HostFilter::new(ce, 5).unwrap());
+    let mut f = boxed::<HostFilter>(&ce, 5).unwrap();
     for m in &frames[..20] {
         f.step(m).unwrap();
     }
@@ -122,7 +123,7 @@ fn cpu_time_per_frame() {
         let (mut ns, mut n, mut parts) = (0u64, 0u64, 0usize);
         for seed in 0..3u64 {
             let ms = maps(&sc, 70 + seed, sc.frames);
-            let mut f = Box::new(HostFilter::new(sc.config(model, particles), seed).unwrap());
+            let mut f = boxed::<HostFilter>(&sc.config(model, particles), seed).unwrap();
             for m in &ms {
                 let t0 = thread_cpu_ns().unwrap_or(0);
                 let r = f.step(m).unwrap();

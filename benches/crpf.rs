@@ -5,14 +5,15 @@
 //! N = 6000 (78 ms per frame). Goal: CRPF-TBD N = 6000 under 0.5 ms per frame.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint::core::detect::jott::JottTbd;
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint::core::detect::{run, Detector};
 use faint::core::model::doppler::{estimate_noise_variance, DopplerReport};
 use faint::core::rng::Rng;
 use faint::core::Complex32;
+use faint::host::instances::boxed;
 use faint::host::simulate::crpf::{Noise, Othr};
 use std::hint::black_box;
 
@@ -38,13 +39,13 @@ fn bench_n<const N: usize>(c: &mut Criterion) {
     group.throughput(Throughput::Elements(run.frames.len() as u64));
     group.sample_size(20);
     let frames = &run.frames;
-    let mut crpf = Box::new(CrpfTbd::<N>::new(CrpfConfig::othr(), 1).unwrap());
+    let mut crpf = boxed::<CrpfTbd<N>>(&CrpfConfig::othr(), 1).unwrap();
     group.bench_function("crpf_tbd", |b| b.iter(|| run_all(crpf.as_mut(), frames)));
-    let mut pf = Box::new(PfTbd::<N>::new(g, 1).unwrap());
+    let mut pf = boxed::<PfTbd<N>>(&g, 1).unwrap();
     group.bench_function("pf_tbd", |b| b.iter(|| run_all(pf.as_mut(), frames)));
-    let mut jott = Box::new(BernoulliTbd::<N>::new(g, 1).unwrap());
+    let mut jott = boxed::<JottTbd<N>>(&g, 1).unwrap();
     group.bench_function("jott", |b| b.iter(|| run_all(jott.as_mut(), frames)));
-    let mut lrt = Box::new(PfLrt::<N>::new(g, 1).unwrap());
+    let mut lrt = boxed::<PfLrt<N>>(&g, 1).unwrap();
     group.bench_function("pf_lrt", |b| b.iter(|| run_all(lrt.as_mut(), frames)));
     group.finish();
 }

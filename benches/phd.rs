@@ -7,6 +7,7 @@ use criterion::{criterion_group, BatchSize, Criterion};
 use faint::core::detect::phd::{Dbscan, DbscanParams};
 use faint::core::detect::Detector;
 use faint::core::rng::Rng;
+use faint::host::instances::boxed;
 use faint::host::instances::phd::HostFilter;
 use faint::host::simulate::phd::{SixTargets, Variant};
 
@@ -24,7 +25,7 @@ fn bench_phd(c: &mut Criterion) {
     g.sample_size(20);
     let mut pts = Vec::new();
     for v in Variant::ALL {
-        let mut f = Box::new(HostFilter::new(sc.config(v), 5).unwrap());
+        let mut f = boxed::<HostFilter>(&sc.config(v), 5).unwrap();
         for cube in &cubes[..20] {
             f.step(cube).unwrap();
         }
@@ -80,7 +81,7 @@ fn cpu_time_per_frame() {
         for seed in 0..3u64 {
             let mut rng = Rng::seed_from_u64(70 + seed);
             let truth = sc.truth(&mut rng);
-            let mut f = Box::new(HostFilter::new(sc.config(v), seed).unwrap());
+            let mut f = boxed::<HostFilter>(&sc.config(v), seed).unwrap();
             let mut cube = Vec::new();
             for frame in &truth {
                 sc.cube(frame, &mut rng, &mut cube);

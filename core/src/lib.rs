@@ -41,7 +41,7 @@
 //!
 //! Map of the crate:
 //! - [`detect`]: the [`detect::Detector`] interface, the generic frame loop
-//!   [`detect::run`], and one module per family (`crpf`, `pf_tbd`, `bernoulli`, `pf_lrt`,
+//!   [`detect::run`], and one module per family (`crpf`, `pf_tbd`, `jott`, `pf_lrt`,
 //!   `mht`, `phd`).
 //! - [`model`]: observation models per input (Doppler frames, plot lists, power cubes).
 //! - [`rng`]: seeded Xoshiro128++ streams and samplers (uniform, normal, exponential,

@@ -2,8 +2,8 @@
 //! existence probabilities (and PF-LRT's log LR) of `N = 64` particles over 10 synthetic
 //! OTHR frames, bit for bit.
 
-use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint_core::detect::jott::JottTbd;
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint_core::detect::Detector;
@@ -93,7 +93,7 @@ pub(crate) fn cases(emit: &mut dyn FnMut(&str, &[u32])) {
         Ok(mut d) => emit("crpf.pf_tbd", &run(&mut d, &model)),
         Err(_) => emit("crpf.pf_tbd", &[ERR]),
     }
-    match BernoulliTbd::<64>::new(g, SEED) {
+    match JottTbd::<64>::new(g, SEED) {
         Ok(mut d) => emit("crpf.jott", &run(&mut d, &model)),
         Err(_) => emit("crpf.jott", &[ERR]),
     }

@@ -69,7 +69,7 @@ pub(crate) fn cases(emit: &mut dyn FnMut(&str, &[u32])) {
     cfg.area = [0.0, 1500.0, 0.0, 1500.0];
     cfg.n_scans = 10;
     cfg.gamma1 = 6;
-    let mut det = Det::unconfigured();
+    let mut det = Det::new_unconfigured();
     let ccfg = ClassicHoughConfig {
         area: cfg.area,
         n_scans: 10,

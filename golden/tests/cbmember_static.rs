@@ -1,20 +1,17 @@
-//! The firmware's CBMeMBer filter (`firmware/src/rows/cbmember.rs`): `configure` on an all-zero
-//! value (how the firmware keeps it in `.bss`) behaves exactly as `new`, and its static
+//! The firmware's CBMeMBer filter (`firmware/src/rows/cbmember.rs`): `configure` on
+//! `new_unconfigured()` (how the firmware keeps it in `.bss`) behaves exactly as `new`, and its static
 //! RAM stays within the 256 KiB goal for a 1000-particle joint filter.
 
-use std::mem::{size_of, MaybeUninit};
+use std::mem::size_of;
 
-use faint_core::detect::cbmember::{CbmemberConfig, CbmemberTbd};
+use faint_core::detect::cbmember::{CbmemberConfig, CbmemberTbdM4, CbmemberTbdSmall};
 use faint_core::detect::Detector;
 use faint_core::model::range_doppler::PointModel;
 use faint_core::rng::Rng;
 use faint_golden::cbmember::{config, map, GOLDEN_WINDOW};
 
-type Firmware = CbmemberTbd<4, 1000, 8192>;
-type Small = CbmemberTbd<3, 96, 256>;
-
-// SAFETY: checked by const evaluation (an invalid all-zero field is a compile error).
-const ZERO: Small = unsafe { MaybeUninit::zeroed().assume_init() };
+type Firmware = CbmemberTbdM4;
+type Small = CbmemberTbdSmall;
 
 #[test]
 fn firmware_filter_fits_256_kib() {
@@ -32,7 +29,7 @@ fn firmware_filter_fits_256_kib() {
 #[test]
 fn configure_on_zero_equals_new() {
     let cfg = config(GOLDEN_WINDOW, PointModel::Joint, 96, 48);
-    let mut a = Box::new(ZERO);
+    let mut a = Box::new(Small::new_unconfigured());
     a.configure(&cfg, 9).unwrap();
     let mut b = Small::new(cfg, 9).unwrap();
     let mut rng = Rng::seed_from_u64(4);

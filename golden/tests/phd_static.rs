@@ -1,18 +1,12 @@
 //! `SmcPhdTbd::reconfigure` restarts a filter in place exactly as `new` builds one,
-//! including from an all-zero value (how the firmware keeps the filter in `static`
+//! including from `new_unconfigured()` (how the firmware keeps the filter in `static`
 //! memory), for the three variants; and the firmware's configuration (window, capacities,
 //! particle counts of `firmware/src/rows/phd.rs`) tracks the shared scene, so its instruction
 //! counts are those of a working filter.
-//!
-//! The all-zero value is a `const` item: the compiler's const evaluator checks that the
-//! zero bit pattern is a valid value of every field (the `PhdConfig`'s enums and `Option`,
-//! `bool`, the generator's state), so a type change that made zeroing unsound would fail
-//! to compile here and on the firmware.
 
 use faint_core::detect::Detector;
-use std::mem::MaybeUninit;
 
-use faint_core::detect::phd::{PhdConfig, PhdReport, SmcPhdTbd};
+use faint_core::detect::phd::{PhdConfig, PhdReport, SmcPhdTbd, SmcPhdTbdM4, SmcPhdTbdSmall};
 use faint_golden::phd::{
     config, cube, truth, Algorithm, ALGORITHMS, FIRMWARE_WINDOW, FRAMES, GOLDEN_WINDOW,
 };
@@ -21,12 +15,9 @@ use faint_golden::SEED;
 use faint_core::model::power_cube::CubeGeometry;
 use faint_core::rng::Rng;
 
-type Small = SmcPhdTbd<256, 256, 4, 4>;
+type Small = SmcPhdTbdSmall;
 /// The firmware's filter (`firmware/src/rows/phd.rs`).
-type Firmware = SmcPhdTbd<6144, 1024, 8, 8>;
-
-// SAFETY: checked by const evaluation (an invalid all-zero field is a compile error).
-const ZERO: Small = unsafe { MaybeUninit::zeroed().assume_init() };
+type Firmware = SmcPhdTbdM4;
 
 /// Per frame: the report, the estimates and the particles (all bits).
 type Trace = Vec<(PhdReport, Vec<[u32; 6]>, Vec<[u32; 6]>)>;
@@ -84,7 +75,7 @@ fn reconfigure_equals_new() {
             v.name
         );
         // From zero.
-        let mut z = Box::new(ZERO);
+        let mut z = Box::new(Small::new_unconfigured());
         z.configure(&cfg(v), 7).unwrap();
         assert_eq!(run(&mut *z, &cubes), want, "{} from zero", v.name);
         // From a filter of another variant (other extractor, with or without the swarm),

@@ -3,7 +3,33 @@
 //! dynamic-programming detectors' sizes stand with their simulator, `simulate::dp`).
 //!
 //! A capacity is a const parameter of a core detector type, fixed at compile time; the
-//! host's instances are large (up to a few MiB), so they are built on the heap.
+//! host's instances are large (`CrpfTbd6000` is 279 KB, the host's PHD filter a few MiB),
+//! so every detector the host runs is built on the heap by [`boxed`], whatever its family
+//! and size: its [`Detector::UNCONFIGURED`] constant is written straight into a heap
+//! allocation ([`unconfigured`]), then [`Detector::configure`] sets it up, exactly as
+//! `new(cfg, seed)` would build it by value.
+
+use anyhow::{anyhow, Result};
+use faint_core::detect::Detector;
+
+/// A configured detector on the heap: [`unconfigured`], then
+/// [`configure`](Detector::configure)`(cfg, seed)`. Errors: the configuration's, as the
+/// core error's one line.
+pub fn boxed<D: Detector>(cfg: &D::Config, seed: u64) -> Result<Box<D>> {
+    let mut det = unconfigured::<D>();
+    det.configure(cfg, seed).map_err(|e| anyhow!("{e}"))?;
+    Ok(det)
+}
+
+/// The unconfigured detector ([`Detector::UNCONFIGURED`]) on the heap, for a caller that
+/// configures it later (or reconfigures it per trial).
+pub fn unconfigured<D: Detector>() -> Box<D> {
+    let mut det = Box::<D>::new_uninit();
+    det.write(D::UNCONFIGURED);
+    // SAFETY: initialised by the `write` above.
+    unsafe { det.assume_init() }
+}
+
 
 // ---------------------------------------------------------------------------------------
 // Instance sizes, one module per family.
@@ -44,21 +70,21 @@ pub mod mht {
 /// The SMC-PHD / PSO-PHD detectors (Pei et al.'s six-target scene).
 pub mod phd {
     /// The host's PHD filter: particles, swarm entries, points, targets.
-    pub type HostFilter = faint_core::detect::phd::SmcPhdTbd<8192, 16384, 10, 16>;
+    pub type HostFilter = faint_core::detect::phd::SmcPhdTbdHost;
 }
 
 /// CBMeMBer-TBD on range-Doppler maps (the rotor-UAV scene).
 pub mod cbmember {
-    use faint_core::detect::cbmember::CbmemberTbd;
+    use faint_core::detect::cbmember::CbmemberTbdHost;
     use faint_core::Complex32;
 
-    /// Particles per Bernoulli component of the host filter.
+    /// Particles per Bernoulli component of the host filter (its `PARTICLES`).
     pub const MAX_PARTICLES: usize = 1500;
     /// The host filter: 4 components of up to [`MAX_PARTICLES`] particles, 256 x 32
     /// block sums, power maps.
-    pub type HostFilter = CbmemberTbd<4, MAX_PARTICLES, 8192, [f32]>;
+    pub type HostFilter = CbmemberTbdHost;
     /// The same on complex maps.
-    pub type HostFilterComplex = CbmemberTbd<4, MAX_PARTICLES, 8192, [Complex32]>;
+    pub type HostFilterComplex = CbmemberTbdHost<[Complex32]>;
     /// The same on quantised `u8` maps.
-    pub type HostFilterU8 = CbmemberTbd<4, MAX_PARTICLES, 8192, [u8]>;
+    pub type HostFilterU8 = CbmemberTbdHost<[u8]>;
 }

@@ -12,7 +12,8 @@
 //!   read from and written to `.npy`/`.npz`/CSV.
 //! - [`reproduce`]: one module per paper, behind `faint reproduce <name>`.
 //! - [`detect`]: every detector on a user's files, behind `faint detect <name>`.
-//! - [`instances`]: every capacity the host builds a detector with.
+//! - [`instances`]: every capacity the host builds a detector with, and the one helper
+//!   that builds every detector the host runs on the heap.
 //! - [`calibrate`]: thresholds at a false-alarm probability, behind `faint calibrate <name>`.
 //! - [`timing`]: this thread's CPU time, for measurements on a shared machine.
 //! - [`cli`]: checks and parsers of command-line values shared by every command.

@@ -157,8 +157,8 @@ mod tests {
 
     #[test]
     fn the_largest_detector_bounds_every_host_instance() {
-        use faint_core::detect::bernoulli::BernoulliTbd;
         use faint_core::detect::crpf::CrpfTbd;
+        use faint_core::detect::jott::JottTbd;
         use faint_core::detect::pf_lrt::PfLrt;
         use faint_core::detect::pf_tbd::PfTbd;
         use std::mem::size_of;
@@ -177,7 +177,7 @@ mod tests {
             size_of::<crate::simulate::dp::fuzz::Second25>(),
             size_of::<CrpfTbd<6000>>(),
             size_of::<PfTbd<6000>>(),
-            size_of::<BernoulliTbd<6000>>(),
+            size_of::<JottTbd<6000>>(),
             size_of::<PfLrt<6000>>(),
         ];
         let largest = sizes.iter().copied().max().unwrap();

@@ -4,8 +4,6 @@
 //! the complex / power / quantised map paths, and a statistical sanity check at fixed
 //! seeds.
 
-use std::mem::MaybeUninit;
-
 use faint::core::detect::cbmember::{CbmemberConfig, CbmemberTbd, Likelihood, DIM};
 use faint::core::detect::{run, Detector};
 use faint::core::model::range_doppler::{
@@ -292,14 +290,13 @@ fn all_zero_likelihoods_kill_every_component() {
     assert_eq!(f.estimates().count(), 0);
 }
 
-/// `configure` on an all-zero value behaves as `new`; complex and power maps give
+/// `configure` on `new_unconfigured()` behaves as `new`; complex and power maps give
 /// bit-identical results; the quantised map stays close.
 #[test]
-fn zeroed_static_complex_and_quantised_paths() {
-    const ZERO: Small = unsafe { MaybeUninit::zeroed().assume_init() };
+fn unconfigured_complex_and_quantised_paths() {
     let cfg = small();
     let maps = small_maps(&cfg, 12, 7, true);
-    let mut a = Box::new(ZERO);
+    let mut a = faint::host::instances::unconfigured::<Small>();
     a.configure(&cfg, 11).unwrap();
     let mut b = Small::new(cfg, 11).unwrap();
     assert_eq!(trace(&mut *a, &maps), trace(&mut b, &maps));

@@ -2,7 +2,7 @@
 //! same predicted law as the exact proposal, so the existence recursion must agree in
 //! expectation; bad shares are typed errors; the output is finite and deterministic.
 
-use faint::core::detect::bernoulli::BernoulliTbd;
+use faint::core::detect::jott::JottTbd;
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd};
 use faint::core::detect::Detector;
@@ -63,12 +63,12 @@ fn exact_is_the_preset_and_bad_shares_are_typed_errors() {
         assert_eq!(b.birth_count::<100>(), Err(bad_share), "{s}");
         let g = cfg(1.0, b);
         assert_eq!(PfTbd::<100>::new(g, 1).unwrap_err(), bad_share, "{s}");
-        assert_eq!(BernoulliTbd::<100>::new(g, 1).unwrap_err(), bad_share);
+        assert_eq!(JottTbd::<100>::new(g, 1).unwrap_err(), bad_share);
         // PF-LRT has no births but shares the config and its check.
         assert_eq!(PfLrt::<100>::new(g, 1).unwrap_err(), bad_share);
     }
     assert!(PfTbd::<1>::new(cfg(1.0, SHARE), 1).is_err());
-    assert!(BernoulliTbd::<1>::new(cfg(1.0, SHARE), 1).is_err());
+    assert!(JottTbd::<1>::new(cfg(1.0, SHARE), 1).is_err());
     assert!(PfTbd::<1>::new(cfg(1.0, BirthProposal::Exact), 1).is_ok());
 
     // A rejected configure leaves the detector as it was: its run equals an untouched one.
@@ -84,14 +84,8 @@ fn exact_is_the_preset_and_bad_shares_are_typed_errors() {
     // Deterministic: the same seed gives the same bits, for both detectors.
     let again = existence(&mut PfTbd::<200>::new(cfg(v, SHARE), 3).unwrap(), &run);
     assert_eq!(again, want);
-    let j1 = existence(
-        &mut BernoulliTbd::<200>::new(cfg(v, SHARE), 3).unwrap(),
-        &run,
-    );
-    let j2 = existence(
-        &mut BernoulliTbd::<200>::new(cfg(v, SHARE), 3).unwrap(),
-        &run,
-    );
+    let j1 = existence(&mut JottTbd::<200>::new(cfg(v, SHARE), 3).unwrap(), &run);
+    let j2 = existence(&mut JottTbd::<200>::new(cfg(v, SHARE), 3).unwrap(), &run);
     assert_eq!(j1, j2);
 }
 
@@ -119,10 +113,7 @@ fn without_information_the_existence_follows_the_chain() {
         *w = q;
     }
     for birth in [BirthProposal::Exact, SHARE] {
-        let e = existence(
-            &mut BernoulliTbd::<250>::new(cfg(1e30, birth), 7).unwrap(),
-            &run,
-        );
+        let e = existence(&mut JottTbd::<250>::new(cfg(1e30, birth), 7).unwrap(), &run);
         for (f, (&got, &w)) in e.iter().zip(&want).enumerate() {
             assert!(
                 (got as f64 - w).abs() < 1e-4,
@@ -191,7 +182,7 @@ fn fixed_share_tracks_at_15_db_like_the_exact_proposal() {
                     (
                         1,
                         existence(
-                            &mut BernoulliTbd::<1000>::new(cfg(v, birth), 100 + s).unwrap(),
+                            &mut JottTbd::<1000>::new(cfg(v, birth), 100 + s).unwrap(),
                             &run,
                         ),
                     ),
@@ -233,10 +224,7 @@ fn fixed_share_h0_existence_stays_low_and_bad_frames_are_handled() {
             let v = var_of(&run);
             for (p, birth) in [BirthProposal::Exact, SHARE].into_iter().enumerate() {
                 let pf = existence(&mut PfTbd::<500>::new(cfg(v, birth), seed).unwrap(), &run);
-                let jo = existence(
-                    &mut BernoulliTbd::<500>::new(cfg(v, birth), seed).unwrap(),
-                    &run,
-                );
+                let jo = existence(&mut JottTbd::<500>::new(cfg(v, birth), seed).unwrap(), &run);
                 m[0][p] += mean(&pf, 1..=32) / 20.0;
                 m[1][p] += mean(&jo, 1..=32) / 20.0;
             }
@@ -253,7 +241,7 @@ fn fixed_share_h0_existence_stays_low_and_bad_frames_are_handled() {
     let zero = vec![Complex32::new(0.0, 0.0); 32];
     let big: Vec<Complex32> = run.frames[8].iter().map(|c| c * 1e12).collect();
     let mut pf = PfTbd::<100>::new(cfg(v, SHARE), 1).unwrap();
-    let mut jo = BernoulliTbd::<100>::new(cfg(v, SHARE), 1).unwrap();
+    let mut jo = JottTbd::<100>::new(cfg(v, SHARE), 1).unwrap();
     for z in [&zero, &zero, &big, &big, &zero]
         .into_iter()
         .chain(run.frames.iter())

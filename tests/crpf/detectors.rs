@@ -1,8 +1,8 @@
 //! Behaviour of CRPF-TBD and its comparators on the OTHR scenario at fixed seeds, and
 //! their handling of bad input.
 
-use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::{CrpfConfig, CrpfTbd, Weighting};
+use faint::core::detect::jott::JottTbd;
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint::core::detect::Detector;
@@ -39,7 +39,7 @@ fn detectors(var: f32, seed: u64) -> Vec<(&'static str, Box<dyn Doppler>)> {
             Box::new(CrpfTbd::<N>::new(CrpfConfig::othr(), seed).unwrap()),
         ),
         ("PF-TBD", Box::new(PfTbd::<N>::new(g, seed).unwrap())),
-        ("JOTT", Box::new(BernoulliTbd::<N>::new(g, seed).unwrap())),
+        ("JOTT", Box::new(JottTbd::<N>::new(g, seed).unwrap())),
         ("PF-LRT", Box::new(PfLrt::<N>::new(g, seed).unwrap())),
     ]
 }
@@ -209,7 +209,7 @@ fn bad_input_is_a_typed_error_or_documented_recovery() {
     }
     // Zero / NaN variance and bad configs are typed errors.
     assert!(PfTbd::<10>::new(GaussConfig::othr(0.0), 1).is_err());
-    assert!(BernoulliTbd::<10>::new(GaussConfig::othr(f32::NAN), 1).is_err());
+    assert!(JottTbd::<10>::new(GaussConfig::othr(f32::NAN), 1).is_err());
     assert!(PfLrt::<10>::new(GaussConfig::othr(-1.0), 1).is_err());
     let mut p = PfLrt::<10>::new(GaussConfig::othr(1.0), 1).unwrap();
     assert!(p.set_noise_variance(0.0).is_err());

@@ -6,8 +6,8 @@
 //! 512-bin capacity, CRPF-TBD's 20 KB cache and 4 KB previous frame, the comparators'
 //! 8 KB whitener).
 
-use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::CrpfTbd;
+use faint::core::detect::jott::JottTbd;
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::PfTbd;
 use faint::core::model::doppler::MAX_BINS;
@@ -40,8 +40,8 @@ fn static_ram_per_configuration() {
     check("CRPF-TBD", 6000, size_of::<CrpfTbd<6000>>(), 41);
     check("PF-TBD", 1000, size_of::<PfTbd<1000>>(), 28);
     check("PF-TBD", 6000, size_of::<PfTbd<6000>>(), 28);
-    check("JOTT", 1000, size_of::<BernoulliTbd<1000>>(), 24);
-    check("JOTT", 6000, size_of::<BernoulliTbd<6000>>(), 24);
+    check("JOTT", 1000, size_of::<JottTbd<1000>>(), 24);
+    check("JOTT", 6000, size_of::<JottTbd<6000>>(), 24);
     check("PF-LRT", 1000, size_of::<PfLrt<1000>>(), 24);
     check("PF-LRT", 6000, size_of::<PfLrt<6000>>(), 24);
 }

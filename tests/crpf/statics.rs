@@ -1,29 +1,18 @@
 //! `configure` restarts a detector in place exactly as `new` builds one, including
-//! from an all-zero value (how the firmware keeps the detectors in `static` memory).
-//!
-//! The all-zero values are `const` items: the compiler's const evaluator checks that
-//! the zero bit pattern is a valid value of every field (enum tags, `Option`, `bool`,
-//! the generator's state), so a type change that made zeroing unsound would fail to
-//! compile here and on the firmware.
+//! from `new_unconfigured()` on the heap (`faint_host::instances`; the firmware keeps
+//! the same value in `static` memory).
 
-use std::mem::MaybeUninit;
-
-use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::{CrpfConfig, CrpfTbd, Weighting};
+use faint::core::detect::jott::JottTbd;
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint::core::detect::Detector;
 use faint::core::model::doppler::{DopplerModel, DopplerReport, Window};
 use faint::core::rng::Rng;
 use faint::core::Complex32;
+use faint::host::instances::unconfigured;
 
 const N: usize = 64;
-
-// SAFETY: checked by const evaluation (an invalid all-zero field is a compile error).
-const ZERO_CRPF: CrpfTbd<N> = unsafe { MaybeUninit::zeroed().assume_init() };
-const ZERO_PF: PfTbd<N> = unsafe { MaybeUninit::zeroed().assume_init() };
-const ZERO_JOTT: BernoulliTbd<N> = unsafe { MaybeUninit::zeroed().assume_init() };
-const ZERO_LRT: PfLrt<N> = unsafe { MaybeUninit::zeroed().assume_init() };
 
 fn frames() -> Vec<[Complex32; 32]> {
     let model = DopplerModel::new(32, 0.02, Window::Hamming).unwrap();
@@ -56,7 +45,7 @@ fn reconfigure_equals_new() {
     let seed = 2017;
     let want = run(&mut CrpfTbd::<N>::new(cfg, seed).unwrap());
     // From zero.
-    let mut z = Box::new(ZERO_CRPF);
+    let mut z = unconfigured::<CrpfTbd<N>>();
     z.configure(&cfg, seed).unwrap();
     assert_eq!(run(&mut *z), want);
     // From a detector with another config, mid-run.
@@ -78,17 +67,17 @@ fn reconfigure_equals_new() {
 
     let g = GaussConfig::othr(12.7);
     let want = run(&mut PfTbd::<N>::new(g, seed).unwrap());
-    let mut z = Box::new(ZERO_PF);
+    let mut z = unconfigured::<PfTbd<N>>();
     z.configure(&g, seed).unwrap();
     assert_eq!(run(&mut *z), want);
 
-    let want = run(&mut BernoulliTbd::<N>::new(g, seed).unwrap());
-    let mut z = Box::new(ZERO_JOTT);
+    let want = run(&mut JottTbd::<N>::new(g, seed).unwrap());
+    let mut z = unconfigured::<JottTbd<N>>();
     z.configure(&g, seed).unwrap();
     assert_eq!(run(&mut *z), want);
 
     let want = run(&mut PfLrt::<N>::new(g, seed).unwrap());
-    let mut z = Box::new(ZERO_LRT);
+    let mut z = unconfigured::<PfLrt<N>>();
     z.configure(&g, seed).unwrap();
     assert_eq!(run(&mut *z), want);
     let bad = GaussConfig {
@@ -160,6 +149,6 @@ fn reconfigure_reuses_the_table_only_for_the_same_frame_format() {
     }
     let cfgs = [g, g_hann, g_slower, g_var];
     check(|c, s| PfTbd::<N>::new(c, s).unwrap(), cfgs);
-    check(|c, s| BernoulliTbd::<N>::new(c, s).unwrap(), cfgs);
+    check(|c, s| JottTbd::<N>::new(c, s).unwrap(), cfgs);
     check(|c, s| PfLrt::<N>::new(c, s).unwrap(), cfgs);
 }

@@ -1,7 +1,7 @@
 //! Whitening by the window's bin covariance (`model::doppler::unwindow`) and the
 //! comparators' window-aware likelihood built on it.
 
-use faint::core::detect::bernoulli::BernoulliTbd;
+use faint::core::detect::jott::JottTbd;
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::GaussConfig;
 use faint::core::detect::Detector;
@@ -133,13 +133,13 @@ fn window_aware_likelihood_is_calibrated_on_noise() {
     for r in 0..runs {
         let run = sc.simulate(None, Noise::Gaussian, &mut Rng::from_stream(404, r));
         let g = GaussConfig::othr(sc.bin_noise_var() as f32);
-        let mut a = BernoulliTbd::<1000>::new(g, r).unwrap();
+        let mut a = JottTbd::<1000>::new(g, r).unwrap();
         // The same windowed frames and variance; the detector whitens them in its step.
         let aware_cfg = GaussConfig {
             likelihood: Likelihood::Window,
             ..g
         };
-        let mut b = BernoulliTbd::<1000>::new(aware_cfg, r).unwrap();
+        let mut b = JottTbd::<1000>::new(aware_cfg, r).unwrap();
         let k = run.frames.len() as f32;
         for f in &run.frames {
             indep += a.step(f).unwrap().existence / (k * runs as f32);
@@ -227,7 +227,7 @@ fn whitener_passes_through_or_rejects() {
         },
         ..GaussConfig::othr(1.0)
     };
-    assert!(BernoulliTbd::<10>::new(hann, 0).is_err());
+    assert!(JottTbd::<10>::new(hann, 0).is_err());
 }
 
 /// The window-aware likelihood on the detector's path equals the former host pre-pass

@@ -2,8 +2,8 @@
 //! (a regression test: CRPF-TBD once reported no detection because its last report was
 //! not kept).
 
-use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint::core::detect::jott::JottTbd;
 use faint::core::detect::mht::MhtConfig;
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
@@ -52,7 +52,7 @@ fn doppler_detections_are_the_reports() {
         &run0.frames,
     );
     check_doppler(
-        &mut *Box::new(BernoulliTbd::<1000>::new(g, 1).unwrap()),
+        &mut *Box::new(JottTbd::<1000>::new(g, 1).unwrap()),
         &run0.frames,
     );
     check_doppler(

@@ -1,12 +1,13 @@
 //! `faint detect` and `faint simulate`: every detector round-trips a simulated file bit
 //! for bit against the reproductions' own code path, bad files and arguments are one
-//! clear line with exit status 2 and nothing written, and the trait's detections agree
-//! with the reports.
+//! clear line with exit status 2 and nothing written, the trait's detections agree
+//! with the reports, and unconfigured detectors refuse to step.
 
 mod bad_input;
 mod commands;
 mod interface;
 mod round_trip;
+mod unconfigured;
 
 #[path = "../common/cli.rs"]
 mod common;

@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint::core::detect::jott::JottTbd;
 use faint::core::detect::mht::MhtConfig;
 use faint::core::detect::pf_lrt::PfLrt;
 use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
@@ -180,7 +180,7 @@ fn doppler_detectors_round_trip() {
     assert_eq!(run("pf-tbd", &gauss_cfg), want);
     let want = doppler_rows(
         &run_detector(
-            &mut *Box::new(BernoulliTbd::<1000>::new(g, DET_SEED).unwrap()),
+            &mut *Box::new(JottTbd::<1000>::new(g, DET_SEED).unwrap()),
             &run0,
         )
         .unwrap(),

@@ -32,7 +32,7 @@ fn mht_gamma_holds_its_rate_on_fresh_clutter() {
     let mut with = 0;
     for i in 0..periods {
         let mut rng = Rng::from_stream(0xF2E5, i);
-        let mut m = Box::new(Mht::unconfigured());
+        let mut m = Box::new(Mht::new_unconfigured());
         m.configure(&at, 0).unwrap();
         let mut tracks = 0;
         for _ in 0..cfg.n_scans {

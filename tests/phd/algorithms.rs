@@ -3,7 +3,8 @@
 //! O(N^2) peeling; swarm invariants (proptest).
 
 use faint::core::detect::phd::dbscan::{Dbscan, DbscanParams, NOISE};
-use faint::core::detect::phd::pso::{crowding_distance, dominates, non_dominated_sort};
+use faint::core::detect::phd::ndsort::{dominates, non_dominated_sort};
+use faint::core::detect::phd::pso::crowding_distance;
 use faint::core::rng::Rng;
 
 /// Textbook DBSCAN: neighbour lists by all-pairs scan.

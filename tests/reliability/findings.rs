@@ -4,8 +4,8 @@
 //! holds (the test checks the typed error) or a documented recovery (the test runs the
 //! detector and checks its outputs are finite).
 
-use faint::core::detect::bernoulli::BernoulliTbd;
 use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint::core::detect::jott::JottTbd;
 use faint::core::detect::mht::censoring::Censor;
 use faint::core::detect::mht::{ClassicHoughConfig, Geometry, MhtConfig, MAX_DRHO_MIN};
 use faint::core::detect::pf_lrt::PfLrt;
@@ -126,7 +126,7 @@ fn pf_lrt_log_likelihood_ratio_saturates() {
     clean(&mut det, &frames);
     let mut pf = PfTbd::<256>::new(g, 1).unwrap();
     clean(&mut pf, &frames);
-    let mut jott = BernoulliTbd::<256>::new(g, 1).unwrap();
+    let mut jott = JottTbd::<256>::new(g, 1).unwrap();
     clean(&mut jott, &frames);
 }
 

@@ -79,6 +79,11 @@ impl Detector for Broken {
     type Report = (u32, f32);
     const STATE: &'static [&'static str] = &["x"];
     const SCORE: ScoreKind = ScoreKind::Merit;
+    const UNCONFIGURED: Self = Broken {
+        cfg: DpConfig::dim_point(Method::Arnold, 1),
+        frames: 0,
+        last: 0.0,
+    };
 
     fn configure(&mut self, cfg: &DpConfig, _seed: u64) -> Result<()> {
         self.cfg = *cfg;
@@ -115,11 +120,7 @@ fn the_checks_catch_a_state_change_on_error_and_a_nan() {
         frame: |rng, _c, mode| reals(rng, 16, mode, 1.0, false),
         max_events: 8,
     };
-    let new = || Broken {
-        cfg: DpConfig::dim_point(Method::Arnold, 1),
-        frames: 0,
-        last: 0.0,
-    };
+    let new = || Broken::UNCONFIGURED;
     let mut pairs = vec![(Box::new(new()), Box::new(new()))];
     let mut rng = Rng::seed_from_u64(13);
     let mut kinds = std::collections::BTreeSet::new();

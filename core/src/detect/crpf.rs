@@ -61,10 +61,11 @@
 //!
 //! Memory: `N * 29` bytes of particles (28 B state, 1 B existence flag) plus `N * 12`
 //! bytes of weights and ancestors and a 33 KB fixed part, the response table (11.7 KB)
-//! and the projection cache (20 KB) (about 279 KB at `N = 6000`): build
+//! and the projection cache (20 KB) (about 279 KB at `PARTICLES = 6000`): build
 //! large instances in a `Box`, or zeroed in a `static` and set up by
 //! [`Detector::configure`].
 
+use crate::detect::interface::unconfigured_is_zero;
 use crate::detect::{Detection, Detector, ScoreKind, Validate};
 use crate::existence::{BirthGaps, ExistenceDraw};
 use crate::math::{self, KahanSum};
@@ -635,18 +636,23 @@ impl RiskCtx<'_> {
     }
 }
 
-/// CRPF-TBD with `N` particles.
+/// CRPF-TBD with 1000 particles (the firmware's instruction table, the host's default).
+pub type CrpfTbd1000 = CrpfTbd<1000>;
+/// CRPF-TBD with 6000 particles (the paper's count; the host's largest).
+pub type CrpfTbd6000 = CrpfTbd<6000>;
+
+/// CRPF-TBD with `PARTICLES` particles (presets [`CrpfTbd1000`], [`CrpfTbd6000`]).
 #[derive(Debug, Clone)]
-pub struct CrpfTbd<const N: usize> {
+pub struct CrpfTbd<const PARTICLES: usize> {
     cfg: CrpfConfig,
     model: Model,
-    parts: [Particle; N],
+    parts: [Particle; PARTICLES],
     /// `E` of each particle.
-    exists: [bool; N],
+    exists: [bool; PARTICLES],
     /// Log risks, then log weights; reused as scratch.
-    log_w: [f32; N],
-    w: [f32; N],
-    anc: [u32; N],
+    log_w: [f32; PARTICLES],
+    w: [f32; PARTICLES],
+    anc: [u32; PARTICLES],
     prev: [Complex32; MAX_BINS],
     prev_zz: f32,
     rng: Rng,
@@ -661,13 +667,20 @@ pub struct CrpfTbd<const N: usize> {
     last: DopplerReport,
 }
 
-impl<const N: usize> CrpfTbd<N> {
+impl<const PARTICLES: usize> CrpfTbd<PARTICLES> {
+    /// The unconfigured detector (a compile-time constant, [`Detector::UNCONFIGURED`]):
+    /// every call but [`Detector::configure`] returns a typed error or nothing until a
+    /// configuration succeeds. For a `static` or a `Box`.
+    pub const fn new_unconfigured() -> Self {
+        <Self as Detector>::UNCONFIGURED
+    }
+
     /// Validates `cfg` and initialises the particles (step 1) from `seed`.
     pub fn new(cfg: CrpfConfig, seed: u64) -> Result<Self> {
-        if N == 0 {
+        if PARTICLES == 0 {
             return Err(Error::InvalidConfig("particle count N = 0"));
         }
-        if u32::try_from(N).is_err() {
+        if u32::try_from(PARTICLES).is_err() {
             return Err(Error::IndexOutOfRange);
         }
         let model = cfg.build()?;
@@ -676,11 +689,11 @@ impl<const N: usize> CrpfTbd<N> {
         let mut s = Self {
             cfg,
             model,
-            parts: [Particle::default(); N],
-            exists: [false; N],
-            log_w: [0.0; N],
-            w: [0.0; N],
-            anc: [0; N],
+            parts: [Particle::default(); PARTICLES],
+            exists: [false; PARTICLES],
+            log_w: [0.0; PARTICLES],
+            w: [0.0; PARTICLES],
+            anc: [0; PARTICLES],
             prev: [Complex32::new(0.0, 0.0); MAX_BINS],
             prev_zz: 0.0,
             rng: Rng::seed_from_u64(seed),
@@ -900,7 +913,7 @@ impl<const N: usize> CrpfTbd<N> {
         self.frame += 1;
         self.last = DopplerReport {
             frame: self.frame,
-            existence: count as f32 / N as f32,
+            existence: count as f32 / PARTICLES as f32,
             log_lr: 0.0,
             estimate: finite_estimate(mean),
             min_cost_estimate: finite_estimate(min),
@@ -972,21 +985,22 @@ impl<const N: usize> CrpfTbd<N> {
     }
 }
 
-impl<const N: usize> Detector for CrpfTbd<N> {
+impl<const PARTICLES: usize> Detector for CrpfTbd<PARTICLES> {
     type Frame = [Complex32];
     type Config = CrpfConfig;
     type Report = DopplerReport;
     const STATE: &'static [&'static str] = DOPPLER_STATE;
     const SCORE: ScoreKind = ScoreKind::Existence;
+    unconfigured_is_zero!();
 
     /// Re-validates `cfg` and restarts in place from `seed` (as [`CrpfTbd::new`] would),
-    /// without building a detector by value: how one that lives in a `static` (e.g. the
-    /// firmware's zero-initialised ones) is set up. On error `self` is unchanged.
+    /// without building a detector by value: how one that lives in a `static` (built by
+    /// [`CrpfTbd::new_unconfigured`]) is set up. On error `self` is unchanged.
     fn configure(&mut self, cfg: &CrpfConfig, seed: u64) -> Result<()> {
-        if N == 0 {
+        if PARTICLES == 0 {
             return Err(Error::InvalidConfig("particle count N = 0"));
         }
-        if u32::try_from(N).is_err() {
+        if u32::try_from(PARTICLES).is_err() {
             return Err(Error::IndexOutOfRange);
         }
         let model = cfg.build_reusing(Some(&self.model.obs))?;

@@ -551,6 +551,14 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
 macro_rules! gauss_detector {
     ($t:ident { $($field:ident: $init:expr),* }, $new_doc:literal, $score:expr) => {
         impl<const N: usize> $t<N> {
+            /// The unconfigured detector (a compile-time constant,
+            /// [`Detector::UNCONFIGURED`](crate::detect::Detector::UNCONFIGURED)): every
+            /// call but `configure` returns a typed error or nothing until a
+            /// configuration succeeds. For a `static` or a `Box`.
+            pub const fn new_unconfigured() -> Self {
+                <Self as $crate::detect::Detector>::UNCONFIGURED
+            }
+
             #[doc = $new_doc]
             pub fn new(
                 cfg: $crate::detect::pf_tbd::GaussConfig,
@@ -576,11 +584,11 @@ macro_rules! gauss_detector {
             type Report = $crate::model::doppler::DopplerReport;
             const STATE: &'static [&'static str] = $crate::model::doppler::DOPPLER_STATE;
             const SCORE: $crate::detect::ScoreKind = $score;
+            $crate::detect::interface::unconfigured_is_zero!();
 
             /// Re-validates `cfg` and restarts in place from `seed` (as `new` would),
             /// without building a detector by value: how one that lives in a `static`
-            /// (e.g. the firmware's zero-initialised ones) is set up. On error `self` is
-            /// unchanged.
+            /// (built by `new_unconfigured`) is set up. On error `self` is unchanged.
             fn configure(
                 &mut self,
                 cfg: &$crate::detect::pf_tbd::GaussConfig,

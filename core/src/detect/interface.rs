@@ -114,6 +114,32 @@ pub trait Validate {
 /// One [`step`](Detector::step) per frame; a frame that fails does so with a typed error
 /// before any state changes. After a successful step,
 /// [`detections`](Detector::detections) iterates what the detector reports for it.
+///
+/// Every detector is built the same way: its `const fn new_unconfigured()` (the constant
+/// [`UNCONFIGURED`](Detector::UNCONFIGURED)), then [`configure`](Detector::configure) in
+/// place. A large detector can therefore live in a `static` (its unconfigured state is
+/// all-zero bits, in `.bss` on a target, for every detector but MHT-TBD) without a copy
+/// through the stack and without `unsafe` for its construction:
+///
+/// ```
+/// use faint_core::detect::crpf::{CrpfConfig, CrpfTbd1000};
+/// use faint_core::detect::Detector;
+/// use faint_core::Complex32;
+/// use std::sync::Mutex;
+///
+/// static DET: Mutex<CrpfTbd1000> = Mutex::new(CrpfTbd1000::new_unconfigured());
+///
+/// let mut det = DET.lock().unwrap();
+/// assert!(det.step(&[Complex32::new(0.0, 0.0); 32]).is_err()); // not configured yet
+/// det.configure(&CrpfConfig::othr(), 7)?;
+/// let report = det.step(&[Complex32::new(0.1, -0.2); 32])?;
+/// assert_eq!(report.frame, 1);
+/// # Ok::<(), faint_core::Error>(())
+/// ```
+///
+/// On a target without `std` the same constant initialises a `static mut`, a
+/// `critical_section::Mutex<RefCell<_>>` or a `static_cell::StaticCell`; on a host,
+/// `Box::new(D::UNCONFIGURED)` then `configure` builds one on the heap.
 pub trait Detector {
     /// One frame of input, borrowed: `[Complex32]` (Doppler frames), `[Plot]` (plot
     /// lists), `[f32]` (power cubes, images).
@@ -127,9 +153,15 @@ pub trait Detector {
     /// What [`Detection::score`] measures.
     const SCORE: ScoreKind;
 
+    /// The unconfigured detector, a compile-time constant (also `new_unconfigured()` on
+    /// every detector). Until [`configure`](Detector::configure) succeeds, every other call
+    /// returns a typed error or nothing. Generic code builds any detector in place from it
+    /// (a `static`, or a `Box` on a host).
+    const UNCONFIGURED: Self;
+
     /// Validates `cfg` against the detector's capacities and restarts in place from
-    /// `seed`, as a new detector would start; on error `self` is unchanged. Works on a
-    /// zero-initialised `static` detector.
+    /// `seed`, as a new detector would start; on error `self` is unchanged. Works on an
+    /// [`UNCONFIGURED`](Detector::UNCONFIGURED) detector, e.g. one in a `static`.
     fn configure(&mut self, cfg: &Self::Config, seed: u64) -> Result<()>;
     /// The configuration in use.
     fn config(&self) -> &Self::Config;
@@ -147,6 +179,22 @@ pub trait Detector {
         Detections { det: self, next: 0 }
     }
 }
+
+/// The `const UNCONFIGURED: Self` item of a detector whose unconfigured state is all-zero
+/// bits (every field: numbers, `bool`, `Option` of numbers, enums with a 0 tag, arrays
+/// and structs of those), so that a `static` of it lands in `.bss`. The one place a
+/// detector is built by zeroing.
+macro_rules! unconfigured_is_zero {
+    () => {
+        // SAFETY: an associated `const` is evaluated by the compiler for every type that
+        // uses it, and the evaluator rejects a value that is invalid for its type (an
+        // enum tag without a variant, a reference, a `NonZero`): a detector with a field
+        // for which all-zero bits are not a valid value fails to compile.
+        #[allow(unsafe_code)]
+        const UNCONFIGURED: Self = unsafe { ::core::mem::MaybeUninit::zeroed().assume_init() };
+    };
+}
+pub(crate) use unconfigured_is_zero;
 
 /// Iterator over a detector's [`Detection`]s (see [`Detector::detections`]).
 #[derive(Debug)]

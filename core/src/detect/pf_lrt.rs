@@ -19,10 +19,15 @@ use crate::math;
 use crate::model::doppler::DopplerReport;
 use crate::{Complex32, Result};
 
-/// PF-LRT with `N` particles.
+/// PF-LRT with 1000 particles (the firmware's comparators, the host's default).
+pub type PfLrt1000 = PfLrt<1000>;
+/// PF-LRT with 6000 particles (the paper's count; the host's largest).
+pub type PfLrt6000 = PfLrt<6000>;
+
+/// PF-LRT with `PARTICLES` particles.
 #[derive(Debug, Clone)]
-pub struct PfLrt<const N: usize> {
-    cloud: GaussianCloud<[f32; 3], N>,
+pub struct PfLrt<const PARTICLES: usize> {
+    cloud: GaussianCloud<[f32; 3], PARTICLES>,
     log_lr: f32,
 }
 
@@ -32,14 +37,14 @@ gauss_detector!(
     crate::detect::ScoreKind::LogLikelihoodRatio
 );
 
-impl<const N: usize> PfLrt<N> {
+impl<const PARTICLES: usize> PfLrt<PARTICLES> {
     /// `ln L_k` so far.
     pub fn log_likelihood_ratio(&self) -> f32 {
         self.log_lr
     }
 }
 
-impl<const N: usize> PfLrt<N> {
+impl<const PARTICLES: usize> PfLrt<PARTICLES> {
     /// One frame (the `Detector::step` of this detector).
     fn advance(&mut self, z: &[Complex32]) -> Result<DopplerReport> {
         let first = self.cloud.frame() == 0;
@@ -49,7 +54,7 @@ impl<const N: usize> PfLrt<N> {
             }
         })?;
         let inc = match self.cloud.normalise() {
-            Some(lse) => lse - math::ln(N as f32),
+            Some(lse) => lse - math::ln(PARTICLES as f32),
             None => 0.0,
         };
         // Saturates at +-f32::MAX (a long run with a tiny noise variance reaches it).

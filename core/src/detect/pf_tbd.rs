@@ -58,10 +58,15 @@ impl CloudParticle for Particle {
     }
 }
 
-/// PF-TBD with `N` particles.
+/// PF-TBD with 1000 particles (the firmware's comparators, the host's default).
+pub type PfTbd1000 = PfTbd<1000>;
+/// PF-TBD with 6000 particles (the paper's count; the host's largest).
+pub type PfTbd6000 = PfTbd<6000>;
+
+/// PF-TBD with `PARTICLES` particles.
 #[derive(Debug, Clone)]
-pub struct PfTbd<const N: usize> {
-    cloud: GaussianCloud<Particle, N>,
+pub struct PfTbd<const PARTICLES: usize> {
+    cloud: GaussianCloud<Particle, PARTICLES>,
 }
 
 gauss_detector!(
@@ -70,11 +75,11 @@ gauss_detector!(
     crate::detect::ScoreKind::Existence
 );
 
-impl<const N: usize> PfTbd<N> {
+impl<const PARTICLES: usize> PfTbd<PARTICLES> {
     /// One frame (the `Detector::step` of this detector).
     fn advance(&mut self, z: &[Complex32]) -> Result<DopplerReport> {
         // Validated at configuration: `None` is the exact proposal.
-        match self.cloud.config().birth.birth_count::<N>() {
+        match self.cloud.config().birth.birth_count::<PARTICLES>() {
             Ok(Some(b)) => self.advance_fixed_share(z, b)?,
             _ => self
                 .cloud
@@ -101,8 +106,8 @@ impl<const N: usize> PfTbd<N> {
         let chain = self.cloud.model().chain;
         let pb = chain.birth();
         let n0 = self.cloud.absent_count();
-        let beta = pb * (n0 as f32 / N as f32);
-        let ln_rest = math::ln((N as u32 - b) as f32);
+        let beta = pb * (n0 as f32 / PARTICLES as f32);
+        let ln_rest = math::ln((PARTICLES as u32 - b) as f32);
         // beta = 0 (no absent particle, or Pb = 0): the births carry no weight; Pb = 1:
         // the absent particles staying absent carry none. Some slot is always finite:
         // a persisting present particle, or (all absent) a birth when Pb > 0, or an

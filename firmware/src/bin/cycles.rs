@@ -29,14 +29,14 @@ use core::mem::MaybeUninit;
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
-use faint_core::detect::bernoulli::BernoulliTbd;
-use faint_core::detect::cbmember::CbmemberTbd;
-use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint_core::detect::cbmember::CbmemberTbdM4;
+use faint_core::detect::crpf::{CrpfConfig, CrpfTbd1000, CrpfTbd6000};
 use faint_core::detect::dp::{DpConfig, DpTrack, Method};
-use faint_core::detect::mht::{MhtConfig, MhtTbd};
-use faint_core::detect::pf_lrt::PfLrt;
-use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint_core::detect::phd::SmcPhdTbd;
+use faint_core::detect::jott::JottTbd1000;
+use faint_core::detect::mht::{MhtConfig, MhtTbdM4};
+use faint_core::detect::pf_lrt::PfLrt1000;
+use faint_core::detect::pf_tbd::{GaussConfig, PfTbd1000};
+use faint_core::detect::phd::SmcPhdTbdM4;
 use faint_core::detect::Detector;
 use faint_core::dp_tbd;
 use faint_core::model::doppler::{DopplerModel, DopplerReport, Window};
@@ -316,19 +316,11 @@ fn micros() {
 
 // ---- detector steps ----------------------------------------------------------------
 
-macro_rules! zeroed {
-    ($name:ident: $t:ty) => {
-        // SAFETY: the const evaluator rejects an all-zero value that is not valid for
-        // every field (enum tags, `Option`, `bool`, the generator's state).
-        static mut $name: $t = unsafe { MaybeUninit::zeroed().assume_init() };
-    };
-}
-
-zeroed!(CRPF_1000: CrpfTbd<1000>);
-zeroed!(PF_1000: PfTbd<1000>);
-zeroed!(JOTT_1000: BernoulliTbd<1000>);
-zeroed!(LRT_1000: PfLrt<1000>);
-zeroed!(CRPF_6000: CrpfTbd<6000>);
+static mut CRPF_1000: CrpfTbd1000 = CrpfTbd1000::new_unconfigured();
+static mut PF_1000: PfTbd1000 = PfTbd1000::new_unconfigured();
+static mut JOTT_1000: JottTbd1000 = JottTbd1000::new_unconfigured();
+static mut LRT_1000: PfLrt1000 = PfLrt1000::new_unconfigured();
+static mut CRPF_6000: CrpfTbd6000 = CrpfTbd6000::new_unconfigured();
 
 /// `src/rows/crpf.rs`'s single-frame row: 6 warm-up frames, then frame 7 measured.
 fn crpf_one(
@@ -389,8 +381,8 @@ fn crpf() {
     );
 }
 
-type Mht = MhtTbd<512, 30, 256, 180, 16>;
-static MHT: Static<Mht> = Static::new(Mht::unconfigured());
+type Mht = MhtTbdM4;
+static MHT: Static<Mht> = Static::new(Mht::new_unconfigured());
 static SCAN: Static<[Plot; 512]> = Static::new([Plot::new(0.0, 0.0, 0.0); 512]);
 
 /// `src/rows/mht.rs`: 29 censoring scans (scan 2 traced), then the period end (traced).
@@ -419,9 +411,9 @@ fn mht() {
     ));
 }
 
-type Phd = SmcPhdTbd<6144, 1024, 8, 8>;
+type Phd = SmcPhdTbdM4;
 const PHD_CELLS: usize = faint_golden::phd::FIRMWARE_WINDOW.len();
-zeroed!(PHD: Phd);
+static mut PHD: Phd = Phd::new_unconfigured();
 static CUBE: Static<[f32; PHD_CELLS]> = Static::new([0.0; PHD_CELLS]);
 
 /// `src/rows/phd.rs`: PHD-TBD frames 0-1 and PSO-PHD-TBD (K-means) frames 0-1 (frame 1 is the
@@ -449,8 +441,8 @@ fn phd() {
     }
 }
 
-type Cbm = CbmemberTbd<4, 1000, 8192, [f32]>;
-zeroed!(CBM: Cbm);
+type Cbm = CbmemberTbdM4;
+static mut CBM: Cbm = Cbm::new_unconfigured();
 static MAP: Static<[f32; 256 * 512]> = Static::new([0.0; 256 * 512]);
 
 /// `src/rows/cbmember.rs`: joint model at 1000 particles, frames 0-1 (frame 1 traced).

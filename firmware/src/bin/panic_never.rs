@@ -15,10 +15,6 @@
 #![no_std]
 #![no_main]
 
-#[path = "../panic_never_common.rs"]
-#[macro_use]
-mod common;
-
 faint_firmware::panic_never!();
 
 use core::hint::black_box;
@@ -39,8 +35,8 @@ const N: usize = 1000;
 /// CBMeMBer TBD on the golden case's 32 x 128 map (16-bin blocks: 256 block sums).
 type Cbm = CbmemberTbd<2, 64, 256>;
 type CbmU8 = CbmemberTbd<2, 64, 256, [u8]>;
-zeroed!(CBM: Cbm);
-zeroed!(CBM_U8: CbmU8);
+static mut CBM: Cbm = Cbm::new_unconfigured();
+static mut CBM_U8: CbmU8 = CbmU8::new_unconfigured();
 static mut MAP: [f32; 32 * 128] = [0.0; 32 * 128];
 static mut MAP_U8: [u8; 32 * 128] = [0; 32 * 128];
 

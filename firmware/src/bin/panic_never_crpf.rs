@@ -20,19 +20,15 @@
 #![no_std]
 #![no_main]
 
-#[path = "../panic_never_common.rs"]
-#[macro_use]
-mod common;
-
 faint_firmware::panic_never!();
 
 use core::hint::black_box;
 
 use cortex_m_rt::entry;
-use faint_core::detect::bernoulli::BernoulliTbd;
-use faint_core::detect::crpf::{CrpfConfig, CrpfTbd, Weighting};
-use faint_core::detect::pf_lrt::PfLrt;
-use faint_core::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd};
+use faint_core::detect::crpf::{CrpfConfig, CrpfTbd, CrpfTbd1000, CrpfTbd6000, Weighting};
+use faint_core::detect::jott::{JottTbd, JottTbd1000, JottTbd6000};
+use faint_core::detect::pf_lrt::{PfLrt, PfLrt1000, PfLrt6000};
+use faint_core::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd, PfTbd1000, PfTbd6000};
 use faint_core::detect::{run as run_frames, Detector, Validate};
 use faint_core::model::doppler::{
     check_frame, dtft, estimate_noise_variance, max_amplitude, unwindow, DopplerModel, Likelihood,
@@ -49,19 +45,19 @@ const M: usize = 32;
 /// `sum w_n^2` of the 32-point window, about 12.1).
 const BIN_VAR: f32 = 12.1;
 
-zeroed!(CRPF_64: CrpfTbd<64>);
-zeroed!(PF_64: PfTbd<64>);
-zeroed!(JOTT_64: BernoulliTbd<64>);
-zeroed!(LRT_64: PfLrt<64>);
-zeroed!(CRPF_1000: CrpfTbd<1000>);
-zeroed!(PF_1000: PfTbd<1000>);
-zeroed!(JOTT_1000: BernoulliTbd<1000>);
-zeroed!(LRT_1000: PfLrt<1000>);
-zeroed!(CRPF_6000: CrpfTbd<6000>);
-zeroed!(PF_6000: PfTbd<6000>);
-zeroed!(JOTT_6000: BernoulliTbd<6000>);
-zeroed!(LRT_6000: PfLrt<6000>);
-zeroed!(CACHE: ProjectionCache);
+static mut CRPF_64: CrpfTbd<64> = <CrpfTbd<64>>::new_unconfigured();
+static mut PF_64: PfTbd<64> = <PfTbd<64>>::new_unconfigured();
+static mut JOTT_64: JottTbd<64> = <JottTbd<64>>::new_unconfigured();
+static mut LRT_64: PfLrt<64> = <PfLrt<64>>::new_unconfigured();
+static mut CRPF_1000: CrpfTbd1000 = CrpfTbd1000::new_unconfigured();
+static mut PF_1000: PfTbd1000 = PfTbd1000::new_unconfigured();
+static mut JOTT_1000: JottTbd1000 = JottTbd1000::new_unconfigured();
+static mut LRT_1000: PfLrt1000 = PfLrt1000::new_unconfigured();
+static mut CRPF_6000: CrpfTbd6000 = CrpfTbd6000::new_unconfigured();
+static mut PF_6000: PfTbd6000 = PfTbd6000::new_unconfigured();
+static mut JOTT_6000: JottTbd6000 = JottTbd6000::new_unconfigured();
+static mut LRT_6000: PfLrt6000 = PfLrt6000::new_unconfigured();
+static mut CACHE: ProjectionCache = ProjectionCache::new();
 
 #[entry]
 fn main() -> ! {
@@ -243,7 +239,7 @@ where
 fn family<const N: usize>(
     crpf: &mut CrpfTbd<N>,
     pf: &mut PfTbd<N>,
-    jott: &mut BernoulliTbd<N>,
+    jott: &mut JottTbd<N>,
     lrt: &mut PfLrt<N>,
     rng: &mut Rng,
 ) -> bool {
@@ -416,7 +412,7 @@ fn by_value(rng: &mut Rng) -> bool {
         Ok(mut d) => ok &= exercise(&mut d, &model, None, rng),
         Err(_) => ok = false,
     }
-    match BernoulliTbd::<8>::new(g, seed) {
+    match JottTbd::<8>::new(g, seed) {
         Ok(mut d) => ok &= exercise(&mut d, &model, None, rng),
         Err(_) => ok = false,
     }

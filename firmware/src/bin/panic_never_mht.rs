@@ -5,9 +5,9 @@
 //! than the capacity, empty scans), `redetect`, `set_gamma1`, the detections and every
 //! other public query of `MhtTbd` and `ClassicHough`, and the public Hough helpers
 //! (`Geometry`, `Accumulator`, `Censor::step`, `dmht::recover`) with arguments out of
-//! their documented ranges, at the firmware's `MhtTbd<512, 30, 256, 180, 16>`, the
-//! golden case's `MhtTbd<48, 10, 32, 30, 4>`, and `ClassicHough<256, 180, 64>` and
-//! `<32, 30, 4>`, on inputs hidden from the optimiser. As in `panic_never.rs`, the panic
+//! their documented ranges, at the firmware's `MhtTbdM4`, the
+//! golden case's `MhtTbdSmall`, and `ClassicHoughHost` and
+//! `ClassicHoughSmall`, on inputs hidden from the optimiser. As in `panic_never.rs`, the panic
 //! handler calls a function that does not exist, so the fat-LTO link fails with an
 //! undefined reference to `faint_core_panic_path_survived` if any panic path survives:
 //!
@@ -20,10 +20,6 @@
 #![no_std]
 #![no_main]
 
-#[path = "../panic_never_common.rs"]
-#[macro_use]
-mod common;
-
 faint_firmware::panic_never!();
 
 use core::hint::black_box;
@@ -32,8 +28,8 @@ use cortex_m_rt::entry;
 use faint_core::detect::mht::censoring::Censor;
 use faint_core::detect::mht::dmht::{recover, Assoc};
 use faint_core::detect::mht::{
-    in_area, Accumulator, ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, Peak,
-    Track,
+    in_area, Accumulator, ClassicHough, ClassicHoughConfig, ClassicHoughHost, ClassicHoughSmall,
+    Geometry, MhtConfig, MhtTbd, MhtTbdM4, MhtTbdSmall, Peak, Track,
 };
 use faint_core::detect::{Detector, Validate};
 use faint_core::model::plot::Plot;
@@ -43,19 +39,19 @@ use faint_firmware::semihosting::finish;
 use faint_firmware::statics::only_ref;
 
 /// The firmware's shape (`firmware/src/rows/mht.rs`).
-type Big = MhtTbd<512, 30, 256, 180, 16>;
+type Big = MhtTbdM4;
 /// The golden case's shape (`golden/src/mht.rs`).
-type Small = MhtTbd<48, 10, 32, 30, 4>;
-type ClassicBig = ClassicHough<256, 180, 64>;
-type ClassicSmall = ClassicHough<32, 30, 4>;
+type Small = MhtTbdSmall;
+type ClassicBig = ClassicHoughHost;
+type ClassicSmall = ClassicHoughSmall;
 
 /// Plot buffer: more than the largest capacity, for the overflow scan.
 const BUF: usize = 600;
 
-static mut BIG: Big = Big::unconfigured();
-static mut SMALL: Small = Small::unconfigured();
-zeroed!(CLASSIC_BIG: ClassicBig);
-zeroed!(CLASSIC_SMALL: ClassicSmall);
+static mut BIG: Big = Big::new_unconfigured();
+static mut SMALL: Small = Small::new_unconfigured();
+static mut CLASSIC_BIG: ClassicBig = ClassicBig::new_unconfigured();
+static mut CLASSIC_SMALL: ClassicSmall = ClassicSmall::new_unconfigured();
 static mut ACC: Accumulator<256, 180> = Accumulator::new();
 static mut CENSOR: Censor<512> = Censor::new();
 static mut FLAGS: [[u8; 512]; 8] = [[0; 512]; 8];

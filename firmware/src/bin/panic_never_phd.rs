@@ -4,7 +4,7 @@
 //! infinite, negative, short and long frames), the detections and every other public
 //! query of `SmcPhdTbd`, with Gaussian and measurement-driven births, the swarm with and
 //! without point refinement, single-cell and merged-cell normalisation, and rejected
-//! configurations, at the firmware's `SmcPhdTbd<6144, 1024, 8, 8>`, the golden case's
+//! configurations, at the firmware's `SmcPhdTbdM4`, the golden case's
 //! `SmcPhdTbd<256, 256, 4, 4>` and a one-target, one-point `SmcPhdTbd<64, 16, 1, 1>`;
 //! plus the public building blocks (`Swarm`, `non_dominated_sort`, `crowding_distance`,
 //! `ndsort::rank_sorted`, `Dbscan`, `KMeans`) with workspaces shorter than their inputs,
@@ -21,10 +21,6 @@
 #![no_std]
 #![no_main]
 
-#[path = "../panic_never_common.rs"]
-#[macro_use]
-mod common;
-
 faint_firmware::panic_never!();
 
 use core::hint::black_box;
@@ -32,9 +28,10 @@ use core::hint::black_box;
 use cortex_m_rt::entry;
 use faint_core::detect::phd::dbscan::{Dbscan, DbscanParams};
 use faint_core::detect::phd::kmeans::KMeans;
+use faint_core::detect::phd::ndsort::non_dominated_sort;
 use faint_core::detect::phd::ndsort::{rank_sorted, Workspace};
-use faint_core::detect::phd::pso::{crowding_distance, non_dominated_sort, PsoConfig, Swarm};
-use faint_core::detect::phd::{BirthMode, SmcPhdTbd};
+use faint_core::detect::phd::pso::{crowding_distance, PsoConfig, Swarm};
+use faint_core::detect::phd::{BirthMode, SmcPhdTbd, SmcPhdTbdM4, SmcPhdTbdSmall};
 use faint_core::detect::Detector;
 use faint_core::model::power_cube::CubeGeometry;
 use faint_core::rng::Rng;
@@ -43,18 +40,18 @@ use faint_firmware::statics::only_ref;
 use faint_golden::phd::{config, cube, ALGORITHMS, FIRMWARE_WINDOW, GOLDEN_WINDOW};
 
 /// The firmware's shape (`firmware/src/rows/phd.rs`).
-type Big = SmcPhdTbd<6144, 1024, 8, 8>;
+type Big = SmcPhdTbdM4;
 /// The golden case's shape (`golden/src/phd.rs`).
-type Small = SmcPhdTbd<256, 256, 4, 4>;
+type Small = SmcPhdTbdSmall;
 /// One target, one swarm point.
 type Tiny = SmcPhdTbd<64, 16, 1, 1>;
 
 /// Cube buffer: one cell more than the firmware window, for the long frame.
 const CELLS: usize = 32 * 32 * 32 + 1;
 
-zeroed!(BIG: Big);
-zeroed!(SMALL: Small);
-zeroed!(TINY: Tiny);
+static mut BIG: Big = Big::new_unconfigured();
+static mut SMALL: Small = Small::new_unconfigured();
+static mut TINY: Tiny = Tiny::new_unconfigured();
 static mut SWARM: Swarm<64, 4> = Swarm::new();
 static mut DBSCAN: Dbscan<128> = Dbscan::new();
 static mut KMEANS: KMeans<128, 4> = KMeans::new();

@@ -22,13 +22,13 @@
 //!
 //! **Sizes** (the preset would take hours under QEMU for some):
 //! - CRPF-TBD, PF-TBD, JOTT, PF-LRT: `N = 1000`, the OTHR preset (noise variance 1).
-//! - MHT-TBD `MhtTbd<640, 30, 256, 180, 32>` and `ClassicHough<256, 180, 64>` with the
+//! - MHT-TBD `MhtTbdHost` and `ClassicHoughHost` with the
 //!   host's sea-clutter configurations.
-//! - PHD-TBD, PSO-PHD-TBD (K-means, DBSCAN): `SmcPhdTbd<1024, 64, 8, 16>` with the golden
+//! - PHD-TBD, PSO-PHD-TBD (K-means, DBSCAN): `SmcPhdTbdSoak` with the golden
 //!   scene's filter settings (`faint_golden::phd::config`: 50 particles per target, 25
 //!   births, at most 32 swarm particles) on an 8 x 8 x 4 window of the golden scene's cells
 //!   (the sizes of the host's `faint soak --shape reduced`, the golden scene's settings).
-//! - CBMeMBer (joint, Doppler-only): `CbmemberTbd<4, 100, 128>`, the `rotor-uav` preset on
+//! - CBMeMBer (joint, Doppler-only): `CbmemberTbdSoak`, the `rotor-uav` preset on
 //!   a 32 x 64 map over the preset's extent, `L_max = 100`, `L_min = 30`, 30 births
 //!   (the host's `faint soak --shape reduced`, `faint_golden::soak::cbmember_reduced`).
 //! - DP-TBD: the first order on 128 x 128 images (the preset), Pulford and the second order
@@ -36,21 +36,18 @@
 #![no_std]
 #![no_main]
 
-use core::mem::MaybeUninit;
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
-use faint_core::detect::bernoulli::BernoulliTbd;
-use faint_core::detect::cbmember::CbmemberTbd;
+use faint_core::detect::cbmember::CbmemberTbdSoak;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
-use faint_core::detect::dp::{
-    arnold_words, pulford_words, second_order_words, ArnoldDp, DpConfig, Method, PulfordDp,
-    SecondOrderDp,
-};
-use faint_core::detect::mht::{ClassicHough, MhtConfig, MhtTbd};
+use faint_core::detect::dp::preset::{Arnold9, Pulford9Reduced, Second9Reduced};
+use faint_core::detect::dp::{DpConfig, Method};
+use faint_core::detect::jott::JottTbd;
+use faint_core::detect::mht::{ClassicHoughHost, MhtConfig, MhtTbdHost};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint_core::detect::phd::{PhdConfig, SmcPhdTbd};
+use faint_core::detect::phd::{PhdConfig, SmcPhdTbdSoak};
 use faint_core::model::doppler::DopplerReport;
 use faint_core::model::plot::Plot;
 use faint_core::model::power_cube::CubeGeometry;
@@ -72,43 +69,33 @@ use faint_golden::soak::{
 faint_firmware::report_panics!();
 
 // ---------------------------------------------------------------------------------------
-// The detectors, each an all-zero `static` set up in place by `configure` (the const
-// evaluator rejects a zero bit pattern that is not a valid value of every field).
-
-macro_rules! zero_static {
-    ($name:ident: $t:ty) => {
-        static $name: Static<$t> = Static::new(
-            // SAFETY: checked by const evaluation (above).
-            unsafe { MaybeUninit::zeroed().assume_init() },
-        );
-    };
-}
+// The detectors, each a `static` of its unconfigured constant set up in place by
+// `configure` (all-zero bits, in `.bss`, but MHT-TBD's).
 
 const N: usize = 1000;
-type Mht = MhtTbd<640, 30, 256, 180, 32>;
-type Classic = ClassicHough<256, 180, 64>;
-type Phd = SmcPhdTbd<1024, 64, 8, 16>;
-type Cbm = CbmemberTbd<4, 100, 128, [f32]>;
-const SIDE: usize = 128;
-const SMALL: usize = 32;
-const L: usize = 40;
-type Arnold = ArnoldDp<SIDE, 9, L, { arnold_words(SIDE, 9, L) }>;
-type Pulford = PulfordDp<SMALL, 9, L, { pulford_words(SMALL, 9, L) }>;
-type Second = SecondOrderDp<SMALL, 9, L, { second_order_words(SMALL, 9, L) }>;
+type Mht = MhtTbdHost;
+type Classic = ClassicHoughHost;
+type Phd = SmcPhdTbdSoak;
+type Cbm = CbmemberTbdSoak;
+const SIDE: usize = faint_core::detect::dp::preset::SIDE;
+const SMALL: usize = faint_core::detect::dp::preset::REDUCED_SIDE;
+type Arnold = Arnold9;
+type Pulford = Pulford9Reduced;
+type Second = Second9Reduced;
 
-zero_static!(CRPF: CrpfTbd<N>);
-zero_static!(PF: PfTbd<N>);
-zero_static!(JOTT: BernoulliTbd<N>);
-zero_static!(LRT: PfLrt<N>);
-zero_static!(LRT_FIXED_RATE: PfLrt<N>);
-zero_static!(LRT_FIXED_AMP: PfLrt<N>);
-static MHT: Static<Mht> = Static::new(Mht::unconfigured());
-zero_static!(CLASSIC: Classic);
-zero_static!(PHD: Phd);
-zero_static!(CBM: Cbm);
-zero_static!(ARNOLD: Arnold);
-zero_static!(PULFORD: Pulford);
-zero_static!(SECOND: Second);
+static CRPF: Static<CrpfTbd<N>> = Static::new(CrpfTbd::new_unconfigured());
+static PF: Static<PfTbd<N>> = Static::new(PfTbd::new_unconfigured());
+static JOTT: Static<JottTbd<N>> = Static::new(JottTbd::new_unconfigured());
+static LRT: Static<PfLrt<N>> = Static::new(PfLrt::new_unconfigured());
+static LRT_FIXED_RATE: Static<PfLrt<N>> = Static::new(PfLrt::new_unconfigured());
+static LRT_FIXED_AMP: Static<PfLrt<N>> = Static::new(PfLrt::new_unconfigured());
+static MHT: Static<Mht> = Static::new(Mht::new_unconfigured());
+static CLASSIC: Static<Classic> = Static::new(Classic::new_unconfigured());
+static PHD: Static<Phd> = Static::new(Phd::new_unconfigured());
+static CBM: Static<Cbm> = Static::new(Cbm::new_unconfigured());
+static ARNOLD: Static<Arnold> = Static::new(Arnold::new_unconfigured());
+static PULFORD: Static<Pulford> = Static::new(Pulford::new_unconfigured());
+static SECOND: Static<Second> = Static::new(Second::new_unconfigured());
 
 const PHD_CELLS: usize = PHD_REDUCED_CELLS[0] * PHD_REDUCED_CELLS[1] * PHD_REDUCED_CELLS[2];
 const MAP: usize = CBMEMBER_REDUCED_PIXELS[0] * CBMEMBER_REDUCED_PIXELS[1];

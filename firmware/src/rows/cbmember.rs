@@ -1,5 +1,5 @@
 //! Cost of CBMeMBer TBD with the joint Doppler / micro-Doppler model (rotor-UAV paper,
-//! 2023) on the Cortex-M4F: `CbmemberTbd<4, 1000, 8192>` (4 Bernoulli components of up
+//! 2023) on the Cortex-M4F: `CbmemberTbdM4` (4 Bernoulli components of up
 //! to 1000 particles, 256 x 32 block sums) on the full 256 x 512 `rotor-uav` map at
 //! -10 dB (the scene of `faint_golden::cbmember`), joint at 700 and 1000 particles,
 //! Doppler-only at 1000, and joint at 1000 on the quantised `u8` map.
@@ -12,10 +12,10 @@
 //! (frame 0 holds only the first birth), per frame and per particle updated.
 
 use core::hint::black_box;
-use core::mem::{size_of, MaybeUninit};
+use core::mem::size_of;
 
 use cortex_m_semihosting::hprintln;
-use faint_core::detect::cbmember::{CbmemberConfig, CbmemberTbd};
+use faint_core::detect::cbmember::{CbmemberConfig, CbmemberTbdM4};
 use faint_core::detect::Detector;
 use faint_core::model::range_doppler::{quantise, Dequant, PointModel, PowerMap};
 use faint_core::rng::Rng;
@@ -30,17 +30,12 @@ const SEED: u64 = 0x0003_CB3E_3BE7_2023;
 const FRAMES: usize = 6;
 const PIXELS: usize = 256 * 512;
 
-type Det = CbmemberTbd<4, 1000, 8192, [f32]>;
-type DetU8 = CbmemberTbd<4, 1000, 8192, [u8]>;
+type Det = CbmemberTbdM4;
+type DetU8 = CbmemberTbdM4<[u8]>;
 
-// SAFETY: the const evaluator rejects (compile error) a zero bit pattern that is not a
-// valid value of every field (the config's enums and bool, the generator's state), so
-// these all-zero values are sound; `configure` sets them up before any `step`.
-const ZERO: Det = unsafe { MaybeUninit::zeroed().assume_init() };
-const ZERO_U8: DetU8 = unsafe { MaybeUninit::zeroed().assume_init() };
-
-static DET: Static<Det> = Static::new(ZERO);
-static DET_U8: Static<DetU8> = Static::new(ZERO_U8);
+// All-zero bits (in `.bss`); `configure` sets them up before any `step`.
+static DET: Static<Det> = Static::new(Det::new_unconfigured());
+static DET_U8: Static<DetU8> = Static::new(DetU8::new_unconfigured());
 static MAP: Static<[f32; PIXELS]> = Static::new([0.0; PIXELS]);
 static MAP_U8: Static<[u8; PIXELS]> = Static::new([0; PIXELS]);
 

@@ -3,9 +3,8 @@
 //!
 //! Each detector runs 6 warm-up frames of the golden sequence (target present from frame
 //! 4), then one `step` on frame 7 (target present) is measured. The detectors live in
-//! `static` memory: each is an all-zero value in `.bss` (the const evaluator checks that
-//! zero is a valid value of every field, see `zeroed!`) set up in place by
-//! `reconfigure`, so nothing of size `N` is built on the stack. The static-RAM column is
+//! `static` memory: each is its `new_unconfigured()` constant (all-zero bits, in `.bss`)
+//! set up in place by `configure`, so nothing of size `N` is built on the stack. The static-RAM column is
 //! their `size_of`.
 //!
 //! CRPF-TBD also gets three rows over 32 detector seeds (frames 1, 6 and 8, see
@@ -14,12 +13,12 @@
 //! `phase: unknown` (the phase-insensitive observation).
 
 use core::hint::black_box;
-use core::mem::{size_of, MaybeUninit};
+use core::mem::size_of;
 
-use faint_core::detect::bernoulli::BernoulliTbd;
-use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
-use faint_core::detect::pf_lrt::PfLrt;
-use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint_core::detect::crpf::{CrpfConfig, CrpfTbd, CrpfTbd1000, CrpfTbd6000};
+use faint_core::detect::jott::{JottTbd, JottTbd1000, JottTbd6000};
+use faint_core::detect::pf_lrt::{PfLrt, PfLrt1000, PfLrt6000};
+use faint_core::detect::pf_tbd::{GaussConfig, PfTbd, PfTbd1000, PfTbd6000};
 use faint_core::detect::Detector;
 use faint_core::model::doppler::{DopplerModel, DopplerReport, Likelihood, Phase, Window};
 use faint_core::rng::Rng;
@@ -114,32 +113,21 @@ fn crpf_rows<const N: usize>(crpf: &mut CrpfTbd<N>, model: &DopplerModel) {
     }
 }
 
-/// An all-zero `static` detector. The initialiser is const-evaluated, and the const
-/// evaluator rejects (compile error) a zero bit pattern that is not a valid value of
-/// every field (enum tags, `Option`, `bool`, the generator's state), so this is sound
-/// for exactly the types it compiles for.
-macro_rules! zeroed {
-    ($name:ident: $t:ty) => {
-        // SAFETY: validity of the all-zero value is checked by const evaluation (above).
-        static mut $name: $t = unsafe { MaybeUninit::zeroed().assume_init() };
-    };
-}
-
-zeroed!(CRPF_1000: CrpfTbd<1000>);
-zeroed!(PF_1000: PfTbd<1000>);
-zeroed!(JOTT_1000: BernoulliTbd<1000>);
-zeroed!(LRT_1000: PfLrt<1000>);
-zeroed!(CRPF_6000: CrpfTbd<6000>);
-zeroed!(PF_6000: PfTbd<6000>);
-zeroed!(JOTT_6000: BernoulliTbd<6000>);
-zeroed!(LRT_6000: PfLrt<6000>);
+static mut CRPF_1000: CrpfTbd1000 = CrpfTbd1000::new_unconfigured();
+static mut PF_1000: PfTbd1000 = PfTbd1000::new_unconfigured();
+static mut JOTT_1000: JottTbd1000 = JottTbd1000::new_unconfigured();
+static mut LRT_1000: PfLrt1000 = PfLrt1000::new_unconfigured();
+static mut CRPF_6000: CrpfTbd6000 = CrpfTbd6000::new_unconfigured();
+static mut PF_6000: PfTbd6000 = PfTbd6000::new_unconfigured();
+static mut JOTT_6000: JottTbd6000 = JottTbd6000::new_unconfigured();
+static mut LRT_6000: PfLrt6000 = PfLrt6000::new_unconfigured();
 
 #[inline(never)]
 fn rows<const N: usize>(
     model: &DopplerModel,
     crpf: &mut CrpfTbd<N>,
     pf: &mut PfTbd<N>,
-    jott: &mut BernoulliTbd<N>,
+    jott: &mut JottTbd<N>,
     lrt: &mut PfLrt<N>,
 ) {
     let g = GaussConfig::othr(BIN_VAR);
@@ -205,7 +193,7 @@ fn rows<const N: usize>(
         n,
         &mut |z| jott.step(z),
         model,
-        size_of::<BernoulliTbd<N>>(),
+        size_of::<JottTbd<N>>(),
     );
     check(lrt.configure(&g, SEED));
     measure_one(

@@ -20,7 +20,7 @@ const P: usize = 512;
 
 type Det = MhtTbd<P, 30, 256, 180, 16>;
 
-static DET: Static<Det> = Static::new(Det::unconfigured());
+static DET: Static<Det> = Static::new(Det::new_unconfigured());
 static SCAN: Static<[Plot; P]> = Static::new([Plot::new(0.0, 0.0, 0.0); P]);
 
 /// Prints the MHT-TBD rows.

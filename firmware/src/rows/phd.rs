@@ -1,5 +1,5 @@
 //! Cost of PHD-TBD, PSO-PHD-TBD (K-means) and PSO-PHD-TBD (DBSCAN) (Pei et al. 2019) on the
-//! Cortex-M4F, in a configuration that fits 1 MiB of RAM: `SmcPhdTbd<6144, 1024, 8, 8>`
+//! Cortex-M4F, in a configuration that fits 1 MiB of RAM: `SmcPhdTbdM4`
 //! (6144 particles, e.g. five targets at the preset's 1000 plus 500 births; a 1024-entry
 //! swarm, so the preset's 512 particles move; 8 measurement points, 8 targets) with the
 //! `six-targets` preset's particle counts (1000 per target, 500 births), on the shared three-target 9 dB scene of `faint_golden::phd` in its
@@ -14,11 +14,11 @@
 //! `harness::measure_long`, which counts the wraps with the board's dual timer.
 
 use core::hint::black_box;
-use core::mem::{size_of, MaybeUninit};
+use core::mem::size_of;
 use faint_core::detect::Detector;
 
 use cortex_m_semihosting::hprintln;
-use faint_core::detect::phd::{PhdConfig, SmcPhdTbd};
+use faint_core::detect::phd::{PhdConfig, SmcPhdTbdM4};
 use faint_core::rng::Rng;
 use faint_golden::phd::{config, cube, ALGORITHMS, FIRMWARE_WINDOW, FRAMES};
 
@@ -33,14 +33,10 @@ const PER_TARGET: usize = 1000;
 const BIRTHS: usize = 500;
 const CELLS: usize = FIRMWARE_WINDOW.len();
 
-type Det = SmcPhdTbd<6144, 1024, 8, 8>;
+type Det = SmcPhdTbdM4;
 
-// SAFETY: the const evaluator rejects (compile error) a zero bit pattern that is not a
-// valid value of every field of `Det` (enum tags, `Option`, `bool`, the generator's
-// state), so this all-zero value is sound; `reconfigure` sets it up before any `step`.
-const ZERO: Det = unsafe { MaybeUninit::zeroed().assume_init() };
-
-static DET: Static<Det> = Static::new(ZERO);
+// All-zero bits (in `.bss`); `configure` sets it up before any `step`.
+static DET: Static<Det> = Static::new(Det::new_unconfigured());
 static CUBE: Static<[f32; CELLS]> = Static::new([0.0; CELLS]);
 
 /// Bytes of static RAM the rows need: the filter and one cube window.

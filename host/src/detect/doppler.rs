@@ -1,11 +1,10 @@
 //! The Doppler-frame detectors: CRPF-TBD and the Gaussian comparators (PF-TBD, JOTT, PF-LRT).
 
 use anyhow::{anyhow, bail, ensure, Result};
-use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint_core::detect::jott::JottTbd;
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint_core::detect::Detector;
 use faint_core::model::doppler::{Likelihood, ModelConfig, Phase, Window};
 use faint_core::Complex32;
 use serde::{Deserialize, Serialize};
@@ -205,52 +204,30 @@ fn doppler_view(f: Frames<Complex32>, ts: f32) -> InputView {
     }
 }
 
-/// Builds a boxed detector of `N` particles and drives it.
+/// Builds a boxed detector of `N` particles configured with `$cfg` and drives it.
 macro_rules! with_particles {
-    ($n:expr, $ty:ident, |$det:ident| $body:expr) => {
+    ($n:expr, $ty:ident, $cfg:expr, $seed:expr, |$det:ident| $body:expr) => {
         match $n {
             1000 => {
-                let $det = Box::new($ty::<1000>::default_for_box()?);
+                let $det = crate::instances::boxed::<$ty<1000>>($cfg, $seed)?;
                 $body
             }
             2000 => {
-                let $det = Box::new($ty::<2000>::default_for_box()?);
+                let $det = crate::instances::boxed::<$ty<2000>>($cfg, $seed)?;
                 $body
             }
             4000 => {
-                let $det = Box::new($ty::<4000>::default_for_box()?);
+                let $det = crate::instances::boxed::<$ty<4000>>($cfg, $seed)?;
                 $body
             }
             6000 => {
-                let $det = Box::new($ty::<6000>::default_for_box()?);
+                let $det = crate::instances::boxed::<$ty<6000>>($cfg, $seed)?;
                 $body
             }
             n => bail!("particles = {n}: must be one of {PARTICLES:?}"),
         }
     };
 }
-
-/// A detector built with a valid preset, to be configured in place by the caller.
-trait DefaultForBox: Sized {
-    fn default_for_box() -> Result<Self>;
-}
-
-impl<const N: usize> DefaultForBox for CrpfTbd<N> {
-    fn default_for_box() -> Result<Self> {
-        CrpfTbd::new(CrpfConfig::othr(), 0).map_err(|e| anyhow!("{e}"))
-    }
-}
-
-macro_rules! gauss_default {
-    ($($t:ident),*) => {$(
-        impl<const N: usize> DefaultForBox for $t<N> {
-            fn default_for_box() -> Result<Self> {
-                $t::new(GaussConfig::othr(1.0), 0).map_err(|e| anyhow!("{e}"))
-            }
-        }
-    )*};
-}
-gauss_default!(PfTbd, BernoulliTbd, PfLrt);
 
 const DOPPLER_POSITION: &[usize] = &[0];
 
@@ -266,9 +243,8 @@ pub(super) fn run_crpf(req: &Request) -> Result<Outcome> {
     normalise(&file, &mut cfg.model, &mut frames, req.input)?;
     valid(&cfg).map_err(|e| anyhow!("with the input's noise level: {e}"))?;
     let read = cpu() - t;
-    let mut out = with_particles!(file.particles, CrpfTbd, |det| {
+    let mut out = with_particles!(file.particles, CrpfTbd, &cfg, req.seed, |det| {
         let mut det = det;
-        det.configure(&cfg, req.seed).map_err(|e| anyhow!("{e}"))?;
         drive(
             "crpf",
             det.as_mut(),
@@ -297,9 +273,8 @@ pub(super) fn run_gauss(req: &Request, name: &'static str) -> Result<Outcome> {
     let read = cpu() - t;
     macro_rules! go {
         ($ty:ident) => {
-            with_particles!(file.particles, $ty, |det| {
+            with_particles!(file.particles, $ty, &cfg, req.seed, |det| {
                 let mut det = det;
-                det.configure(&cfg, req.seed).map_err(|e| anyhow!("{e}"))?;
                 drive(
                     name,
                     det.as_mut(),
@@ -312,7 +287,7 @@ pub(super) fn run_gauss(req: &Request, name: &'static str) -> Result<Outcome> {
     }
     let mut out = match name {
         "pf-tbd" => go!(PfTbd),
-        "jott" => go!(BernoulliTbd),
+        "jott" => go!(JottTbd),
         _ => go!(PfLrt),
     };
     out.view = doppler_view(frames, cfg.model.ts);

@@ -80,8 +80,7 @@ pub fn mht_gamma(config: &MhtConfig, lambda: f64, pfa: f64, seed: u64) -> Result
     step_cfg.gamma1 = (n + 1).min(255) as u8;
     let counts: Vec<Result<Vec<bool>>> =
         crate::montecarlo::run_trials(seed, periods, "gamma_1 from clutter", |_, rng| {
-            let mut m = Box::new(Mht::unconfigured());
-            m.configure(&step_cfg, 0).map_err(|e| anyhow!("{e}"))?;
+            let mut m = crate::instances::boxed::<Mht>(&step_cfg, 0)?;
             let mut with = vec![false; n + 2];
             for _ in 0..n {
                 let k = crate::simulate::mht::poisson(rng, lambda as f32);
@@ -180,8 +179,7 @@ pub(super) fn run_mht(req: &Request) -> Result<Outcome> {
         ));
     }
     let read = cpu() - t;
-    let mut det = Box::new(Mht::unconfigured());
-    det.configure(&cfg, req.seed).map_err(|e| anyhow!("{e}"))?;
+    let mut det = crate::instances::boxed::<Mht>(&cfg, req.seed)?;
     let mut out = drive(
         "mht",
         det.as_mut(),
@@ -228,7 +226,7 @@ pub(super) fn run_classic(req: &Request) -> Result<Outcome> {
         ));
     }
     let read = cpu() - t;
-    let mut det = Box::new(Classic::new(cfg).map_err(|e| anyhow!("{e}"))?);
+    let mut det = crate::instances::boxed::<Classic>(&cfg, 0)?;
     det.configure(&cfg, req.seed).map_err(|e| anyhow!("{e}"))?;
     let mut out = drive(
         "hough-classic",

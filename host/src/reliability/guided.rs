@@ -34,10 +34,10 @@ use std::fmt::{self, Debug};
 use std::thread::LocalKey;
 
 use arbitrary::Unstructured;
-use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::cbmember::{CbmemberConfig, CbmemberTbd, Likelihood};
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd, Weighting};
 use faint_core::detect::dp::{DpConfig, Method, Transition};
+use faint_core::detect::jott::JottTbd;
 use faint_core::detect::mht::{ClassicHoughConfig, MhtConfig};
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd};
@@ -497,6 +497,14 @@ fn with_pairs<D: 'static, R>(
     })
 }
 
+/// A detector configured with a fuzz shape's own preset (seed 0), on the heap.
+fn preset<D: Detector>(cfg: &D::Config) -> Box<D> {
+    match crate::instances::boxed::<D>(cfg, 0) {
+        Ok(d) => d,
+        Err(e) => panic!("the fuzz shape rejects its own preset: {e}"),
+    }
+}
+
 fn built<D>(r: faint_core::Result<D>) -> Box<D> {
     match r {
         Ok(d) => Box::new(d),
@@ -671,7 +679,7 @@ macro_rules! thread_pair {
 
 thread_pair!(CRPF, CrpfTbd<PARTICLES>);
 thread_pair!(PF_TBD, PfTbd<PARTICLES>);
-thread_pair!(JOTT, BernoulliTbd<PARTICLES>);
+thread_pair!(JOTT, JottTbd<PARTICLES>);
 thread_pair!(PF_LRT, PfLrt<PARTICLES>);
 thread_pair!(MHT, Mht);
 thread_pair!(CLASSIC, Classic);
@@ -703,35 +711,35 @@ fn spec<D: Detector + ?Sized, T>(
 /// CRPF-TBD on one input.
 pub fn crpf(data: &[u8]) -> Result<Summary, Failure> {
     let s = spec("crpf", crpf_bases(), crpf_frame);
-    let make = || built(CrpfTbd::new(crpf_bases()[0], 0));
+    let make = || preset::<CrpfTbd<PARTICLES>>(&crpf_bases()[0]);
     with_pairs(&CRPF, make, |p| run(&s, p, data))
 }
 
 /// PF-TBD on one input.
 pub fn pf_tbd(data: &[u8]) -> Result<Summary, Failure> {
     let s = spec("pf-tbd", gauss_bases(), gauss_frame);
-    let make = || built(PfTbd::new(gauss_bases()[0], 0));
+    let make = || preset::<PfTbd<PARTICLES>>(&gauss_bases()[0]);
     with_pairs(&PF_TBD, make, |p| run(&s, p, data))
 }
 
 /// JOTT on one input.
 pub fn jott(data: &[u8]) -> Result<Summary, Failure> {
     let s = spec("jott", gauss_bases(), gauss_frame);
-    let make = || built(BernoulliTbd::new(gauss_bases()[0], 0));
+    let make = || preset::<JottTbd<PARTICLES>>(&gauss_bases()[0]);
     with_pairs(&JOTT, make, |p| run(&s, p, data))
 }
 
 /// PF-LRT on one input.
 pub fn pf_lrt(data: &[u8]) -> Result<Summary, Failure> {
     let s = spec("pf-lrt", gauss_bases(), gauss_frame);
-    let make = || built(PfLrt::new(gauss_bases()[0], 0));
+    let make = || preset::<PfLrt<PARTICLES>>(&gauss_bases()[0]);
     with_pairs(&PF_LRT, make, |p| run(&s, p, data))
 }
 
 /// MHT-TBD (the host's capacities) on one input.
 pub fn mht(data: &[u8]) -> Result<Summary, Failure> {
     let s = spec("mht", mht_bases(), mht_frame);
-    let make = || built(Mht::new(MhtConfig::sea_clutter()));
+    let make = || preset::<Mht>(&MhtConfig::sea_clutter());
     with_pairs(&MHT, make, |p| run(&s, p, data))
 }
 
@@ -741,13 +749,13 @@ pub fn hough_classic(data: &[u8]) -> Result<Summary, Failure> {
     static BASES: std::sync::OnceLock<Vec<ClassicHoughConfig>> = std::sync::OnceLock::new();
     let bases = BASES.get_or_init(classic_bases);
     let s = spec("hough-classic", bases.clone(), classic_frame);
-    let make = || built(Classic::new(bases[0]));
+    let make = || preset::<Classic>(&bases[0]);
     with_pairs(&CLASSIC, make, |p| run(&s, p, data))
 }
 
 fn phd(name: &'static str, v: Variant, data: &[u8]) -> Result<Summary, Failure> {
     let s = spec(name, phd_bases(v), phd_frame);
-    let make = || built(Phd::new(phd_bases(Variant::PhdTbd)[0], 0));
+    let make = || preset::<Phd>(&phd_bases(Variant::PhdTbd)[0]);
     with_pairs(&PHD, make, |p| run(&s, p, data))
 }
 
@@ -768,7 +776,7 @@ pub fn pso_phd_dbscan(data: &[u8]) -> Result<Summary, Failure> {
 
 fn cbm(name: &'static str, model: PointModel, data: &[u8]) -> Result<Summary, Failure> {
     let s = spec(name, cbm_bases(model), cbm_frame);
-    let make = || built(Cbm::new(cbm_bases(PointModel::Joint)[0], 0));
+    let make = || preset::<Cbm>(&cbm_bases(PointModel::Joint)[0]);
     with_pairs(&CBM, make, |p| run(&s, p, data))
 }
 

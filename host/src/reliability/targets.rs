@@ -5,11 +5,11 @@
 //! extent instead of 142 x 150 x 90) so that a case costs milliseconds; the arithmetic
 //! the campaign probes is the same at any size.
 
-use anyhow::{anyhow, bail, Result};
-use faint_core::detect::bernoulli::BernoulliTbd;
+use anyhow::{bail, Result};
 use faint_core::detect::cbmember::CbmemberConfig;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
 use faint_core::detect::dp::{DpConfig, Method};
+use faint_core::detect::jott::JottTbd;
 use faint_core::detect::mht::MhtConfig;
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
@@ -27,6 +27,7 @@ use super::frames::{self, complex, len_or_short, plots, reals, Mode};
 use super::soak::{soak, Shape, Soak, WorkCounters};
 use super::{fuzz, Options, Tally, Target};
 use crate::detect::default_classic;
+use crate::instances::boxed;
 use crate::instances::cbmember::HostFilter as CbmemberHost;
 use crate::instances::mht::{Classic, Mht, PLOTS as MHT_PLOTS};
 use crate::instances::phd::HostFilter as PhdHost;
@@ -127,12 +128,9 @@ fn image_reduced(rng: &mut Rng, _c: &DpConfig, mode: Mode) -> Vec<f32> {
     reals(rng, REDUCED_SIDE * REDUCED_SIDE, mode, DP_SCALE, false)
 }
 
-fn pair<D>(
-    make: impl Fn() -> std::result::Result<D, faint_core::Error>,
-) -> Result<(Box<D>, Box<D>)> {
-    let a = Box::new(make().map_err(|e| anyhow!("{e}"))?);
-    let b = Box::new(make().map_err(|e| anyhow!("{e}"))?);
-    Ok((a, b))
+/// Two detectors configured with `cfg` (seed 0), on the heap.
+fn pair<D: Detector>(cfg: &D::Config) -> Result<(Box<D>, Box<D>)> {
+    Ok((boxed::<D>(cfg, 0)?, boxed::<D>(cfg, 0)?))
 }
 
 /// What to do with a detector.
@@ -190,7 +188,7 @@ pub fn run(name: &str, job: Job) -> Result<Outcome> {
                     name,
                     to_value(&c),
                     doppler_crpf,
-                    pair(|| CrpfTbd::<PARTICLES>::new(c, 0))?,
+                    pair::<CrpfTbd<PARTICLES>>(&c)?,
                     o,
                 )
             }
@@ -201,38 +199,32 @@ pub fn run(name: &str, job: Job) -> Result<Outcome> {
                         name,
                         to_value(&c),
                         doppler_gauss,
-                        pair(|| PfTbd::<PARTICLES>::new(c, 0))?,
+                        pair::<PfTbd<PARTICLES>>(&c)?,
                         o,
                     ),
                     "jott" => go(
                         name,
                         to_value(&c),
                         doppler_gauss,
-                        pair(|| BernoulliTbd::<PARTICLES>::new(c, 0))?,
+                        pair::<JottTbd<PARTICLES>>(&c)?,
                         o,
                     ),
                     _ => go(
                         name,
                         to_value(&c),
                         doppler_gauss,
-                        pair(|| PfLrt::<PARTICLES>::new(c, 0))?,
+                        pair::<PfLrt<PARTICLES>>(&c)?,
                         o,
                     ),
                 }
             }
             "mht" => {
                 let c = MhtConfig::sea_clutter();
-                go(name, to_value(&c), scan_mht, pair(|| Mht::new(c))?, o)
+                go(name, to_value(&c), scan_mht, pair::<Mht>(&c)?, o)
             }
             "hough-classic" => {
                 let c = default_classic();
-                go(
-                    name,
-                    to_value(&c),
-                    scan_classic,
-                    pair(|| Classic::new(c))?,
-                    o,
-                )
+                go(name, to_value(&c), scan_classic, pair::<Classic>(&c)?, o)
             }
             "phd-tbd" | "pso-phd-kmeans" | "pso-phd-dbscan" => {
                 let v = match name {
@@ -245,7 +237,7 @@ pub fn run(name: &str, job: Job) -> Result<Outcome> {
                 } else {
                     small_phd(v)
                 };
-                go(name, to_value(&c), cube, pair(|| PhdHost::new(c, 0))?, o)
+                go(name, to_value(&c), cube, pair::<PhdHost>(&c)?, o)
             }
             "cbmember" | "cbmember-doppler" => {
                 let model = if name == "cbmember" {
@@ -259,13 +251,7 @@ pub fn run(name: &str, job: Job) -> Result<Outcome> {
                     Shape::Preset
                 };
                 let c = cbmember_config(model, shape);
-                go(
-                    name,
-                    to_value(&c),
-                    map,
-                    pair(|| CbmemberHost::new(c, 0))?,
-                    o,
-                )
+                go(name, to_value(&c), map, pair::<CbmemberHost>(&c)?, o)
             }
             "dp-arnold" | "dp-pulford" | "dp-second" => {
                 let m = match name {

@@ -392,7 +392,7 @@ fn mca(t: &Tracer, r: &trace::Totals, k: usize, dir: &str) -> Result<Option<Loop
 const FAMILIES: [(&str, &[&str]); 7] = [
     (
         "CRPF-TBD, PF-TBD, JOTT, PF-LRT",
-        &["crpf", "pf_tbd", "bernoulli", "pf_lrt"],
+        &["crpf", "pf_tbd", "jott", "bernoulli", "pf_lrt"],
     ),
     ("MHT-TBD, classic Hough", &["mht", "hough", "dmht"]),
     (

@@ -45,6 +45,7 @@
 
 use core::marker::PhantomData;
 
+use crate::detect::interface::unconfigured_is_zero;
 use crate::detect::{Detection, Detector, ScoreKind, TrackInfo, Validate};
 use crate::existence::ExistenceMarkov;
 use crate::math;
@@ -204,7 +205,7 @@ pub struct CbmemberConfig {
     pub blades: u32,
     /// Estimate `B` in `1..=4` (births uniform, moves with `process.blade_move`).
     pub estimate_blades: bool,
-    /// Particles of a component of existence 1 (`L_max`, at most the capacity `P`).
+    /// Particles of a component of existence 1 (`L_max`, at most the capacity `PARTICLES`).
     pub max_particles: usize,
     /// Fewest particles of a component (`L_min`).
     pub min_particles: usize,
@@ -311,7 +312,7 @@ impl Validate for CbmemberConfig {
             return Err(Error::InvalidConfig("dt"));
         }
         if let Likelihood::Blocked { bins } = self.likelihood {
-            if bins == 0 || self.geometry.n_velocity % bins != 0 {
+            if bins == 0 || !self.geometry.n_velocity.is_multiple_of(bins) {
                 return Err(Error::InvalidConfig("likelihood.bins"));
             }
         }
@@ -405,34 +406,48 @@ pub struct Estimate {
     pub particles: usize,
 }
 
-/// One Bernoulli component: existence and `P` particles.
+/// One Bernoulli component: existence and `PARTICLES` particles.
 #[derive(Debug, Clone)]
-struct Component<const P: usize> {
+struct Component<const PARTICLES: usize> {
     live: bool,
     r: f32,
     n: usize,
     id: u32,
     age: u32,
     est: [f32; DIM],
-    x: [[f32; DIM]; P],
-    w: [f32; P],
+    x: [[f32; DIM]; PARTICLES],
+    w: [f32; PARTICLES],
 }
 
-/// The filter with capacities: `C` Bernoulli components, `P` particles per component,
-/// `S` block sums (`n_range * n_velocity / bins` for the blocked likelihood; unused by
+/// The firmware's filter: 4 components of up to 1000 particles, 256 x 32 block sums.
+pub type CbmemberTbdM4<F = [f32]> = CbmemberTbd<4, 1000, 8192, F>;
+/// The host's filter: 4 components of up to 1500 particles, 256 x 32 block sums.
+pub type CbmemberTbdHost<F = [f32]> = CbmemberTbd<4, 1500, 8192, F>;
+/// The golden case's filter: 3 components of 96 particles, 256 block sums.
+pub type CbmemberTbdSmall<F = [f32]> = CbmemberTbd<3, 96, 256, F>;
+/// The soak run's filter: 4 components of 100 particles, 128 block sums.
+pub type CbmemberTbdSoak<F = [f32]> = CbmemberTbd<4, 100, 128, F>;
+
+/// The filter with capacities: `COMPONENTS` Bernoulli components, `PARTICLES` particles
+/// per component, `BLOCK_SUMS` block sums (`n_range * n_velocity / bins` for the blocked likelihood; unused by
 /// the exact one), frame type `F` (`[f32]` power map `|y|^2`, `[Complex32]`, or `[u8]`
 /// quantised).
 ///
-/// Memory: about `C (32 P + 48) + 6 P + 4 S + 9 KB` bytes (e.g. 170 KB at `C = 4`,
-/// `P = 1000`, `S = 8192`). Build large instances in a `Box` or zeroed in a `static` and
-/// set up by [`Detector::configure`].
+/// Memory: about `C (32 P + 48) + 6 P + 4 S + 9 KB` bytes with `C = COMPONENTS`,
+/// `P = PARTICLES`, `S = BLOCK_SUMS` (e.g. 170 KB at `C = 4`, `P = 1000`, `S = 8192`). Build large instances in a `Box` or a `static` from
+/// [`CbmemberTbd::new_unconfigured`] and set up by [`Detector::configure`].
 #[derive(Debug)]
-pub struct CbmemberTbd<const C: usize, const P: usize, const S: usize, F: ?Sized = [f32]> {
+pub struct CbmemberTbd<
+    const COMPONENTS: usize,
+    const PARTICLES: usize,
+    const BLOCK_SUMS: usize,
+    F: ?Sized = [f32],
+> {
     cfg: CbmemberConfig,
-    comps: [Component<P>; C],
-    lw: [f32; P],
-    anc: [u16; P],
-    blocks: [f32; S],
+    comps: [Component<PARTICLES>; COMPONENTS],
+    lw: [f32; PARTICLES],
+    anc: [u16; PARTICLES],
+    blocks: [f32; BLOCK_SUMS],
     h: [f32; MAX_VELOCITY_BINS],
     p: [f32; 2 * MAX_VELOCITY_BINS],
     kernel: Kernel,
@@ -441,7 +456,7 @@ pub struct CbmemberTbd<const C: usize, const P: usize, const S: usize, F: ?Sized
     rng: Rng,
     next_id: u32,
     frames: u32,
-    reported: [u16; C],
+    reported: [u16; COMPONENTS],
     n_reported: usize,
     /// Range of the previous frame's profile peak ([`BirthPlacement::RangePeak`]).
     birth_peak: f32,
@@ -450,7 +465,9 @@ pub struct CbmemberTbd<const C: usize, const P: usize, const S: usize, F: ?Sized
 }
 
 // By hand: a derive would ask `F: Clone` of the (unsized) frame type.
-impl<const C: usize, const P: usize, const S: usize, F: ?Sized> Clone for CbmemberTbd<C, P, S, F> {
+impl<const COMPONENTS: usize, const PARTICLES: usize, const BLOCK_SUMS: usize, F: ?Sized> Clone
+    for CbmemberTbd<COMPONENTS, PARTICLES, BLOCK_SUMS, F>
+{
     fn clone(&self) -> Self {
         Self {
             cfg: self.cfg,
@@ -528,33 +545,86 @@ fn wrap_angle(t: f32) -> f32 {
     }
 }
 
-impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> CbmemberTbd<C, P, S, F> {
-    /// Checks `cfg` against the capacities (`C, P >= 1`, `P <= 65 536`, `L_max <= P`,
-    /// birth particles `<= P`, block sums `<= S`).
+impl<
+        const COMPONENTS: usize,
+        const PARTICLES: usize,
+        const BLOCK_SUMS: usize,
+        F: ?Sized + PowerMap,
+    > CbmemberTbd<COMPONENTS, PARTICLES, BLOCK_SUMS, F>
+{
+    /// The unconfigured filter (a compile-time constant, [`Detector::UNCONFIGURED`]):
+    /// every call but [`Detector::configure`] returns a typed error or nothing until a
+    /// configuration succeeds. For a `static` or a `Box`.
+    pub const fn new_unconfigured() -> Self {
+        <Self as Detector>::UNCONFIGURED
+    }
+
+    /// A configured filter built by value (small capacities; use
+    /// [`new_unconfigured`](Self::new_unconfigured) in a `Box` or a `static` with
+    /// [`Detector::configure`] for large ones).
+    pub fn new(cfg: CbmemberConfig, seed: u64) -> Result<Self> {
+        Self::check(&cfg)?;
+        let comp = Component {
+            live: false,
+            r: 0.0,
+            n: 0,
+            id: 0,
+            age: 0,
+            est: [0.0; DIM],
+            x: [[0.0; DIM]; PARTICLES],
+            w: [0.0; PARTICLES],
+        };
+        let mut f = Self {
+            cfg,
+            comps: core::array::from_fn(|_| comp.clone()),
+            lw: [0.0; PARTICLES],
+            anc: [0; PARTICLES],
+            blocks: [0.0; BLOCK_SUMS],
+            h: [0.0; MAX_VELOCITY_BINS],
+            p: [0.0; 2 * MAX_VELOCITY_BINS],
+            kernel: Kernel::default(),
+            dq: Dequant::new(1.0, 1.0),
+            c0: 0.0,
+            rng: Rng::seed_from_u64(seed),
+            next_id: 1,
+            frames: 0,
+            reported: [0; COMPONENTS],
+            n_reported: 0,
+            birth_peak: 0.0,
+            has_peak: false,
+            _frame: PhantomData,
+        };
+        f.configure(&cfg, seed)?;
+        Ok(f)
+    }
+
+    /// Checks `cfg` against the capacities (`COMPONENTS, PARTICLES >= 1`,
+    /// `PARTICLES <= 65 536`, `L_max <= PARTICLES`, birth particles `<= PARTICLES`, block
+    /// sums `<= BLOCK_SUMS`).
     fn check(cfg: &CbmemberConfig) -> Result<()> {
         cfg.validate()?;
-        if C == 0 || P == 0 || C > u16::MAX as usize {
+        if COMPONENTS == 0 || PARTICLES == 0 || COMPONENTS > u16::MAX as usize {
             return Err(Error::InvalidConfig("capacities"));
         }
-        if P > 1 << 16 {
+        if PARTICLES > 1 << 16 {
             return Err(Error::Capacity {
                 capacity: 1 << 16,
-                requested: P,
+                requested: PARTICLES,
             });
         }
         for n in [cfg.max_particles, cfg.birth.particles] {
-            if n > P {
+            if n > PARTICLES {
                 return Err(Error::Capacity {
-                    capacity: P,
+                    capacity: PARTICLES,
                     requested: n,
                 });
             }
         }
         if let Likelihood::Blocked { bins } = cfg.likelihood {
             let need = cfg.geometry.n_range * (cfg.geometry.n_velocity / bins.max(1));
-            if need > S {
+            if need > BLOCK_SUMS {
                 return Err(Error::Capacity {
-                    capacity: S,
+                    capacity: BLOCK_SUMS,
                     requested: need,
                 });
             }
@@ -668,7 +738,7 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
 
     /// The slot a birth goes to: a free one, else the weakest component's if its
     /// existence is below the birth's.
-    fn birth_slot(comps: &[Component<P>], existence: f32) -> Option<usize> {
+    fn birth_slot(comps: &[Component<PARTICLES>], existence: f32) -> Option<usize> {
         if let Some(k) = comps.iter().position(|c| !c.live) {
             return Some(k);
         }
@@ -733,7 +803,7 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
             let id = self.next_id;
             self.next_id = self.next_id.wrapping_add(1).max(1);
             if let Some(c) = self.comps.get_mut(k) {
-                let n = cfg.birth.particles.min(P);
+                let n = cfg.birth.particles.min(PARTICLES);
                 for x in c.x.iter_mut().take(n) {
                     *x = Self::birth_particle(&cfg, self.frames, peak, &mut self.rng);
                 }
@@ -750,7 +820,7 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
 
         // 3. Update, 4. estimate, 5. resample.
         for c in self.comps.iter_mut().filter(|c| c.live) {
-            let n = c.n.min(P);
+            let n = c.n.min(PARTICLES);
             rep.particles += n;
             let (Some(x), Some(w), Some(lw)) =
                 (c.x.get(..n), c.w.get_mut(..n), self.lw.get_mut(..n))
@@ -787,7 +857,7 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
             let l = (math::round(c.r * cfg.max_particles as f32) as usize)
                 .max(cfg.min_particles)
                 .min(cfg.max_particles)
-                .min(P);
+                .min(PARTICLES);
             let Some(anc) = self.anc.get_mut(..l) else {
                 continue;
             };
@@ -813,8 +883,8 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
         }
         let [gr, gv] = cfg.merge_gate;
         if gr > 0.0 || gv > 0.0 {
-            for a in 0..C {
-                for b in (a + 1)..C {
+            for a in 0..COMPONENTS {
+                for b in (a + 1)..COMPONENTS {
                     let (Some(ca), Some(cb)) = (self.comps.get(a), self.comps.get(b)) else {
                         continue;
                     };
@@ -842,7 +912,7 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
 
         // 7. Report.
         self.n_reported = 0;
-        for k in 0..C {
+        for k in 0..COMPONENTS {
             let Some(c) = self.comps.get_mut(k) else {
                 continue;
             };
@@ -853,7 +923,7 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Cbmem
             rep.max_existence = rep.max_existence.max(c.r);
             if c.r > cfg.report_threshold {
                 // The circular mean of theta, for the reported components only.
-                let n = c.n.min(P);
+                let n = c.n.min(PARTICLES);
                 if let (Some(x), Some(w)) = (c.x.get(..n), c.w.get(..n)) {
                     c.est[idx::THETA] = estimate(x, w, true)[idx::THETA];
                 }
@@ -957,8 +1027,12 @@ fn estimate(x: &[[f32; DIM]], w: &[f32], circular: bool) -> [f32; DIM] {
     acc
 }
 
-impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Detector
-    for CbmemberTbd<C, P, S, F>
+impl<
+        const COMPONENTS: usize,
+        const PARTICLES: usize,
+        const BLOCK_SUMS: usize,
+        F: ?Sized + PowerMap,
+    > Detector for CbmemberTbd<COMPONENTS, PARTICLES, BLOCK_SUMS, F>
 {
     type Frame = F;
     type Config = CbmemberConfig;
@@ -972,6 +1046,7 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Detec
         "theta_rad",
     ];
     const SCORE: ScoreKind = ScoreKind::Existence;
+    unconfigured_is_zero!();
 
     /// Validates `cfg` against the capacities and restarts in place from `seed`; works on
     /// an all-zero value (a `static` in `.bss`). On error `self` is unchanged.
@@ -1027,45 +1102,5 @@ impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> Detec
                 len: e.age,
             }),
         ))
-    }
-}
-
-impl<const C: usize, const P: usize, const S: usize, F: ?Sized + PowerMap> CbmemberTbd<C, P, S, F> {
-    /// A configured filter built by value (small capacities; use a `Box` or a zeroed
-    /// `static` with [`Detector::configure`] for large ones).
-    pub fn new(cfg: CbmemberConfig, seed: u64) -> Result<Self> {
-        Self::check(&cfg)?;
-        let comp = Component {
-            live: false,
-            r: 0.0,
-            n: 0,
-            id: 0,
-            age: 0,
-            est: [0.0; DIM],
-            x: [[0.0; DIM]; P],
-            w: [0.0; P],
-        };
-        let mut f = Self {
-            cfg,
-            comps: core::array::from_fn(|_| comp.clone()),
-            lw: [0.0; P],
-            anc: [0; P],
-            blocks: [0.0; S],
-            h: [0.0; MAX_VELOCITY_BINS],
-            p: [0.0; 2 * MAX_VELOCITY_BINS],
-            kernel: Kernel::default(),
-            dq: Dequant::new(1.0, 1.0),
-            c0: 0.0,
-            rng: Rng::seed_from_u64(seed),
-            next_id: 1,
-            frames: 0,
-            reported: [0; C],
-            n_reported: 0,
-            birth_peak: 0.0,
-            has_peak: false,
-            _frame: PhantomData,
-        };
-        f.configure(&cfg, seed)?;
-        Ok(f)
     }
 }

@@ -548,7 +548,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         bit0: usize,
     ) -> i32 {
         let store = |words: &mut [u32], bit: usize, acc: u32, n: u32| {
-            if M % 8 == 0 && n == 32 {
+            if M.is_multiple_of(8) && n == 32 {
                 if let Some(w) = words.get_mut(bit >> 5) {
                     *w = acc;
                 }
@@ -581,7 +581,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         let w = bit0 >> 5;
         match words.get_mut(w..w + M / 4) {
             // rows of whole words: stored in order
-            Some(wr) if M % 8 == 0 => {
+            Some(wr) if M.is_multiple_of(8) => {
                 let (w0, w1) = wr.split_at_mut(M / 8);
                 let it = cells
                     .chunks_exact(32)
@@ -752,7 +752,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         } else {
             let r = Self::R;
             let slot = ((k - 2) as usize) % Self::LP.max(1);
-            if !slow && r == 1 && M % 2 == 0 {
+            if !slow && r == 1 && M.is_multiple_of(2) {
                 (best, bxy) = self.run3(frame, quant.inv_lsb, sub, slot);
                 tally.advance(sub, best, bxy, clamped);
                 return;

@@ -433,6 +433,7 @@ impl<R: Recursion> Detector for DpTbd<R> {
     type Report = DpReport;
     const STATE: &'static [&'static str] = STATE;
     const SCORE: ScoreKind = ScoreKind::Merit;
+    const UNCONFIGURED: Self = Self::new_unconfigured();
 
     /// Checks `cfg` (the detector's method, `L >= 1`, a supported window no larger than
     /// the image, the method's tables), then restarts in place. No random numbers:

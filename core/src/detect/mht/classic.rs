@@ -6,6 +6,7 @@
 use super::dmht::{Accumulator, CondenseStats, Peak};
 use super::geometry::Geometry;
 use super::{in_area, validate_area};
+use crate::detect::interface::unconfigured_is_zero;
 use crate::detect::{Detection, Detector, ScoreKind, Validate};
 use crate::model::plot::Plot;
 use crate::{Error, Result};
@@ -55,20 +56,36 @@ pub struct ClassicHoughReport {
     pub condense: CondenseStats,
 }
 
-/// Streaming classic Hough TBD with up to `T` peaks per period.
+/// The host's classic detector (`faint reproduce mht`, the soak run): a 256 x 180 grid,
+/// 64 peaks.
+pub type ClassicHoughHost = ClassicHough<256, 180, 64>;
+/// The golden case's classic detector: a 32 x 30 grid, 4 peaks.
+pub type ClassicHoughSmall = ClassicHough<32, 30, 4>;
+
+/// Streaming classic Hough TBD on a `RHO_CELLS x THETA_CELLS` grid with up to `PEAKS`
+/// peaks per period.
 #[derive(Debug, Clone)]
-pub struct ClassicHough<const R: usize, const A: usize, const T: usize> {
+pub struct ClassicHough<const RHO_CELLS: usize, const THETA_CELLS: usize, const PEAKS: usize> {
     cfg: ClassicHoughConfig,
-    geom: Geometry<R, A>,
-    acc: Accumulator<R, A>,
+    geom: Geometry<RHO_CELLS, THETA_CELLS>,
+    acc: Accumulator<RHO_CELLS, THETA_CELLS>,
     scan: usize,
-    peaks: [Peak; T],
+    peaks: [Peak; PEAKS],
     npeaks: usize,
     /// The last step completed a period.
     done: bool,
 }
 
-impl<const R: usize, const A: usize, const T: usize> ClassicHough<R, A, T> {
+impl<const RHO_CELLS: usize, const THETA_CELLS: usize, const PEAKS: usize>
+    ClassicHough<RHO_CELLS, THETA_CELLS, PEAKS>
+{
+    /// The unconfigured detector (a compile-time constant, [`Detector::UNCONFIGURED`]):
+    /// every call but [`Detector::configure`] returns a typed error or nothing until a
+    /// configuration succeeds. For a `static` or a `Box`.
+    pub const fn new_unconfigured() -> Self {
+        <Self as Detector>::UNCONFIGURED
+    }
+
     /// A detector for a validated configuration.
     pub fn new(cfg: ClassicHoughConfig) -> Result<Self> {
         cfg.validate()?;
@@ -77,19 +94,19 @@ impl<const R: usize, const A: usize, const T: usize> ClassicHough<R, A, T> {
             geom: Geometry::for_area(cfg.area),
             acc: Accumulator::new(),
             scan: 0,
-            peaks: [Peak::default(); T],
+            peaks: [Peak::default(); PEAKS],
             npeaks: 0,
             done: false,
         })
     }
 
     /// Geometry (origin, rho cells).
-    pub fn geometry(&self) -> &Geometry<R, A> {
+    pub fn geometry(&self) -> &Geometry<RHO_CELLS, THETA_CELLS> {
         &self.geom
     }
 
     /// Accumulator (counts of the current/last period).
-    pub fn accumulator(&self) -> &Accumulator<R, A> {
+    pub fn accumulator(&self) -> &Accumulator<RHO_CELLS, THETA_CELLS> {
         &self.acc
     }
 
@@ -132,12 +149,15 @@ impl<const R: usize, const A: usize, const T: usize> ClassicHough<R, A, T> {
     }
 }
 
-impl<const R: usize, const A: usize, const T: usize> Detector for ClassicHough<R, A, T> {
+impl<const RHO_CELLS: usize, const THETA_CELLS: usize, const PEAKS: usize> Detector
+    for ClassicHough<RHO_CELLS, THETA_CELLS, PEAKS>
+{
     type Frame = [Plot];
     type Config = ClassicHoughConfig;
     type Report = ClassicHoughReport;
     const STATE: &'static [&'static str] = &["rho_m", "theta_rad"];
     const SCORE: ScoreKind = ScoreKind::Count;
+    unconfigured_is_zero!();
 
     /// Validates `cfg`, builds the geometry and starts a new period. The classic Hough
     /// TBD draws no random numbers: `seed` is unused.
@@ -181,7 +201,7 @@ impl<const R: usize, const A: usize, const T: usize> Detector for ClassicHough<R
         }
         let p = self.peaks.get(i)?;
         let (r, a) = (usize::from(p.r), usize::from(p.a));
-        if r >= R || a >= A {
+        if r >= RHO_CELLS || a >= THETA_CELLS {
             return None;
         }
         Some(Detection::new(

@@ -17,18 +17,20 @@
 //!
 //! Bad input, all counted in the report, never a panic:
 //! - plots with NaN/inf fields or outside the surveillance area are skipped (`invalid`);
-//! - plots beyond the capacity `P` of a scan are skipped (`overflow`);
-//! - gated pairs beyond `P` per scan pair and chains beyond `4 P` per scan are skipped
-//!   ([`CensorStats`]); peaks beyond `T` are dropped weakest first ([`CondenseStats`]);
+//! - plots beyond the capacity `PLOTS` of a scan are skipped (`overflow`);
+//! - gated pairs beyond `PLOTS` per scan pair and chains beyond `4 PLOTS` per scan are
+//!   skipped ([`CensorStats`]); peaks beyond `TRACKS` are dropped weakest first
+//!   ([`CondenseStats`]);
 //! - degenerate geometry (all effective plots at one point): the DMHT rho range is
 //!   floored at `drho_min` so the transform is defined (every curve passes through the
 //!   middle rho cell); a period without effective plots reports zero tracks;
-//! - zero scans per period, `M` outside `3..=8`, `N > NS` or `N > 64`, a non-finite or
+//! - zero scans per period, `M` outside `3..=8`, `N > SCANS` or `N > 64`, a non-finite or
 //!   empty area: [`Error::InvalidConfig`] at construction.
 //!
-//! Memory (all fixed at compile time): the period's plots `NS x P` (12 B each) plus one
-//! flag byte each, the censoring pair ring `8 x P x 4 B` and x-sort keys `P x 8 B`, the
-//! accumulator `R x A x 4 B` and `T` tracks of `NS` indices.
+//! Memory (all fixed at compile time): the period's plots `SCANS x PLOTS` (12 B each) plus
+//! one flag byte each, the censoring pair ring `8 x PLOTS x 4 B` and x-sort keys
+//! `PLOTS x 8 B`, the accumulator `RHO_CELLS x THETA_CELLS x 4 B` and `TRACKS` tracks of
+//! `SCANS` indices.
 
 pub mod censoring;
 pub mod classic;
@@ -36,7 +38,9 @@ pub mod dmht;
 pub mod geometry;
 
 pub use censoring::{CensorStats, MAX_M};
-pub use classic::{ClassicHough, ClassicHoughConfig, ClassicHoughReport};
+pub use classic::{
+    ClassicHough, ClassicHoughConfig, ClassicHoughHost, ClassicHoughReport, ClassicHoughSmall,
+};
 pub use dmht::{Accumulator, CondenseStats, Peak, Track, NO_PLOT};
 pub use geometry::Geometry;
 
@@ -47,9 +51,9 @@ use crate::{math, Error, Result};
 use censoring::{Censor, FLAG_EFFECTIVE};
 
 /// Kept plots of scan `s` of a period store (`counts[s] <= P`; empty past the store).
-fn kept<'a, const P: usize, const NS: usize>(
-    plots: &'a [[Plot; P]; NS],
-    counts: &[u16; NS],
+fn kept<'a, const PLOTS: usize, const SCANS: usize>(
+    plots: &'a [[Plot; PLOTS]; SCANS],
+    counts: &[u16; SCANS],
     s: usize,
 ) -> &'a [Plot] {
     match (plots.get(s), counts.get(s)) {
@@ -59,12 +63,12 @@ fn kept<'a, const P: usize, const NS: usize>(
 }
 
 /// The first `ns` scans of a period store: `(plots, flags, kept count)` each.
-fn period<'a, const P: usize, const NS: usize>(
-    plots: &'a [[Plot; P]; NS],
-    flags: &'a [[u8; P]; NS],
-    counts: &'a [u16; NS],
+fn period<'a, const PLOTS: usize, const SCANS: usize>(
+    plots: &'a [[Plot; PLOTS]; SCANS],
+    flags: &'a [[u8; PLOTS]; SCANS],
+    counts: &'a [u16; SCANS],
     ns: usize,
-) -> impl Iterator<Item = (&'a [Plot; P], &'a [u8; P], usize)> + 'a {
+) -> impl Iterator<Item = (&'a [Plot; PLOTS], &'a [u8; PLOTS], usize)> + 'a {
     plots
         .iter()
         .zip(flags)
@@ -74,9 +78,9 @@ fn period<'a, const P: usize, const NS: usize>(
 }
 
 /// The effective plots among the first `n` of a scan, with their indices.
-fn effective<'a, const P: usize>(
-    plots: &'a [Plot; P],
-    flags: &'a [u8; P],
+fn effective<'a, const PLOTS: usize>(
+    plots: &'a [Plot; PLOTS],
+    flags: &'a [u8; PLOTS],
     n: usize,
 ) -> impl Iterator<Item = (&'a Plot, usize)> + 'a {
     plots
@@ -187,7 +191,7 @@ impl MhtConfig {
 }
 
 impl Validate for MhtConfig {
-    /// Checks the values (the capacity `NS` of a detector is checked by its
+    /// Checks the values (the capacity `SCANS` of a detector is checked by its
     /// [`Detector::configure`]).
     fn validate(&self) -> Result<()> {
         validate_area(self.area)?;
@@ -260,7 +264,7 @@ pub struct MhtReport {
     pub plots_kept: u16,
     /// Plots skipped: non-finite or outside the area.
     pub invalid: u32,
-    /// Plots skipped: beyond the capacity `P`.
+    /// Plots skipped: beyond the capacity `PLOTS`.
     pub overflow: u32,
     /// Censoring counters of this scan's window.
     pub censor: CensorStats,
@@ -268,20 +272,34 @@ pub struct MhtReport {
     pub detection: Option<PeriodSummary>,
 }
 
-/// Streaming MHT-TBD detector: `P` plots per scan, `NS` scans per period at most, an
-/// `R x A` Hough grid, `T` tracks per period.
+/// The firmware's detector: 512 plots per scan, 30 scans, a 256 x 180 grid, 16 tracks.
+pub type MhtTbdM4 = MhtTbd<512, 30, 256, 180, 16>;
+/// The host's detector (`faint reproduce mht`, the soak run): 640 plots per scan, 30
+/// scans, a 256 x 180 grid, 32 tracks.
+pub type MhtTbdHost = MhtTbd<640, 30, 256, 180, 32>;
+/// The golden case's detector: 48 plots per scan, 10 scans, a 32 x 30 grid, 4 tracks.
+pub type MhtTbdSmall = MhtTbd<48, 10, 32, 30, 4>;
+
+/// Streaming MHT-TBD detector: `PLOTS` plots per scan, `SCANS` scans per period at most,
+/// a `RHO_CELLS x THETA_CELLS` Hough grid, `TRACKS` tracks per period.
 #[derive(Debug, Clone)]
-pub struct MhtTbd<const P: usize, const NS: usize, const R: usize, const A: usize, const T: usize> {
+pub struct MhtTbd<
+    const PLOTS: usize,
+    const SCANS: usize,
+    const RHO_CELLS: usize,
+    const THETA_CELLS: usize,
+    const TRACKS: usize,
+> {
     cfg: MhtConfig,
-    msht: Geometry<R, A>,
-    dmht: Geometry<R, A>,
-    plots: [[Plot; P]; NS],
-    counts: [u16; NS],
-    flags: [[u8; P]; NS],
-    censor: Censor<P>,
-    acc: Accumulator<R, A>,
-    peaks: [Peak; T],
-    tracks: [Track<NS>; T],
+    msht: Geometry<RHO_CELLS, THETA_CELLS>,
+    dmht: Geometry<RHO_CELLS, THETA_CELLS>,
+    plots: [[Plot; PLOTS]; SCANS],
+    counts: [u16; SCANS],
+    flags: [[u8; PLOTS]; SCANS],
+    censor: Censor<PLOTS>,
+    acc: Accumulator<RHO_CELLS, THETA_CELLS>,
+    peaks: [Peak; TRACKS],
+    tracks: [Track<SCANS>; TRACKS],
     ntracks: usize,
     scan: usize,
     /// Stage-3 input summary of the period the last `step` completed (for
@@ -289,29 +307,35 @@ pub struct MhtTbd<const P: usize, const NS: usize, const R: usize, const A: usiz
     period: Option<PeriodSummary>,
 }
 
-impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: usize>
-    MhtTbd<P, NS, R, A, T>
+impl<
+        const PLOTS: usize,
+        const SCANS: usize,
+        const RHO_CELLS: usize,
+        const THETA_CELLS: usize,
+        const TRACKS: usize,
+    > MhtTbd<PLOTS, SCANS, RHO_CELLS, THETA_CELLS, TRACKS>
 {
     /// A detector for a configuration (validated here). The struct is large
     /// (`~ NS P 13 + R A 4` bytes): box it on the host, make it `static` on a target.
     pub fn new(cfg: MhtConfig) -> Result<Self> {
-        let mut d = Self::unconfigured();
+        let mut d = Self::new_unconfigured();
         d.configure(&cfg, 0)?;
         Ok(d)
     }
 
-    /// A zeroed detector for `static` storage (compile-time constant, lands in `.bss`
-    /// on a target). [`MhtTbd::configure`] must succeed before `step`; until then `step`
+    /// The unconfigured detector for `static` or `Box` storage (a compile-time
+    /// constant, [`Detector::UNCONFIGURED`]; not all-zero bits: its scan index is
+    /// `usize::MAX`). [`MhtTbd::configure`] must succeed before `step`; until then `step`
     /// returns `Error::InvalidConfig("unconfigured")`.
-    pub const fn unconfigured() -> Self {
+    pub const fn new_unconfigured() -> Self {
         const EMPTY: Plot = Plot::new(0.0, 0.0, 0.0);
         Self {
             cfg: MhtConfig::sea_clutter(),
             msht: Geometry::placeholder(),
             dmht: Geometry::placeholder(),
-            plots: [[EMPTY; P]; NS],
-            counts: [0; NS],
-            flags: [[0; P]; NS],
+            plots: [[EMPTY; PLOTS]; SCANS],
+            counts: [0; SCANS],
+            flags: [[0; PLOTS]; SCANS],
             censor: Censor::new(),
             acc: Accumulator::new(),
             peaks: [Peak {
@@ -320,8 +344,8 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
                 value16: 0,
                 raw: 0,
                 cells: 0,
-            }; T],
-            tracks: [Track::empty(); T],
+            }; TRACKS],
+            tracks: [Track::empty(); TRACKS],
             ntracks: 0,
             scan: usize::MAX,
             period: None,
@@ -338,17 +362,17 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     }
 
     /// Single-frame (MSHT) geometry: origin at the area centre.
-    pub fn msht_geometry(&self) -> &Geometry<R, A> {
+    pub fn msht_geometry(&self) -> &Geometry<RHO_CELLS, THETA_CELLS> {
         &self.msht
     }
 
     /// DMHT geometry of the last completed period.
-    pub fn dmht_geometry(&self) -> &Geometry<R, A> {
+    pub fn dmht_geometry(&self) -> &Geometry<RHO_CELLS, THETA_CELLS> {
         &self.dmht
     }
 
     /// DMHT accumulator of the last completed period.
-    pub fn accumulator(&self) -> &Accumulator<R, A> {
+    pub fn accumulator(&self) -> &Accumulator<RHO_CELLS, THETA_CELLS> {
         &self.acc
     }
 
@@ -377,7 +401,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     }
 
     /// Confirmed tracks of the last completed period, strongest peak first.
-    pub fn tracks(&self) -> &[Track<NS>] {
+    pub fn tracks(&self) -> &[Track<SCANS>] {
         self.tracks.get(..self.ntracks).unwrap_or(&[])
     }
 
@@ -385,12 +409,12 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     /// bad plots.
     fn step_scan(&mut self, scan_plots: &[Plot]) -> Result<MhtReport> {
         let s = self.scan;
-        if s >= NS {
+        if s >= SCANS {
             return Err(Error::InvalidConfig("unconfigured"));
         }
         self.period = None;
         if s == 0 {
-            self.counts = [0; NS];
+            self.counts = [0; SCANS];
             self.ntracks = 0;
         }
         let mut rep = MhtReport {
@@ -403,7 +427,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
         for p in scan_plots {
             if !in_area(p, self.cfg.area) || !p.amplitude.is_finite() {
                 rep.invalid += 1;
-            } else if n < P {
+            } else if n < PLOTS {
                 self.plots[s][n] = *p;
                 n += 1;
             } else {
@@ -419,7 +443,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
         {
             let plots = &self.plots;
             let counts = &self.counts;
-            let scans: [&[Plot]; NS] = core::array::from_fn(|i| kept(plots, counts, i));
+            let scans: [&[Plot]; SCANS] = core::array::from_fn(|i| kept(plots, counts, i));
             rep.censor = self.censor.step(
                 &self.msht,
                 &scans[..=s],
@@ -468,7 +492,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     /// smoothing of `S_ep`.
     fn integrate(&mut self) -> PeriodSummary {
         // n_scans <= NS (configure checks it)
-        let ns = self.cfg.n_scans.min(NS);
+        let ns = self.cfg.n_scans.min(SCANS);
         let mut det = PeriodSummary::default();
         // centroid and extent of S_ep (f64-free: two-pass in f32 about the area centre)
         let (ax, ay) = self.msht.origin();
@@ -521,7 +545,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     /// and confirmation (an empty accumulator gives no peaks).
     fn extract(&mut self, gamma1: u8, mut det: PeriodSummary) -> PeriodSummary {
         // n_scans <= NS (configure checks it)
-        let ns = self.cfg.n_scans.min(NS);
+        let ns = self.cfg.n_scans.min(SCANS);
         det.condense = self.acc.condense(gamma1, &mut self.peaks);
         // track recovery
         let assoc = dmht::Assoc {
@@ -531,12 +555,12 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
         };
         let plots = &self.plots;
         let counts = &self.counts;
-        let scans: [&[Plot]; NS] = core::array::from_fn(|i| kept(plots, counts, i));
+        let scans: [&[Plot]; SCANS] = core::array::from_fn(|i| kept(plots, counts, i));
         let mut nt = 0usize;
-        for i in 0..usize::from(det.condense.peaks).min(T) {
+        for i in 0..usize::from(det.condense.peaks).min(TRACKS) {
             let pk = self.peaks[i];
-            let mut tr = Track::<NS>::default();
-            dmht::recover::<R, A, P, NS>(
+            let mut tr = Track::<SCANS>::default();
+            dmht::recover::<RHO_CELLS, THETA_CELLS, PLOTS, SCANS>(
                 &self.dmht,
                 pk,
                 &scans[..ns],
@@ -592,30 +616,36 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
     }
 }
 
-impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: usize> Detector
-    for MhtTbd<P, NS, R, A, T>
+impl<
+        const PLOTS: usize,
+        const SCANS: usize,
+        const RHO_CELLS: usize,
+        const THETA_CELLS: usize,
+        const TRACKS: usize,
+    > Detector for MhtTbd<PLOTS, SCANS, RHO_CELLS, THETA_CELLS, TRACKS>
 {
     type Frame = [Plot];
     type Config = MhtConfig;
     type Report = MhtReport;
     const STATE: &'static [&'static str] = &["x_m", "y_m", "vx_m_per_scan", "vy_m_per_scan"];
     const SCORE: ScoreKind = ScoreKind::Count;
+    const UNCONFIGURED: Self = Self::new_unconfigured();
 
     /// Validates `cfg` against the capacities (`n_scans <= NS`, `0 < P <= 65535`,
     /// `T > 0`), builds the geometry and starts a new period, in place (no large copy,
     /// usable on a `static`). MHT-TBD draws no random numbers: `seed` is unused.
     fn configure(&mut self, cfg: &MhtConfig, _seed: u64) -> Result<()> {
         cfg.validate()?;
-        if cfg.n_scans > NS {
+        if cfg.n_scans > SCANS {
             return Err(Error::InvalidConfig("n_scans"));
         }
-        if P > usize::from(u16::MAX) || P == 0 || T == 0 {
+        if PLOTS > usize::from(u16::MAX) || PLOTS == 0 || TRACKS == 0 {
             return Err(Error::InvalidConfig("capacity"));
         }
         self.cfg = *cfg;
         self.msht = Geometry::for_area(cfg.area);
         self.dmht = self.msht;
-        self.counts = [0; NS];
+        self.counts = [0; SCANS];
         self.ntracks = 0;
         self.scan = 0;
         self.period = None;
@@ -628,8 +658,8 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
 
     /// Starts a new period (an unconfigured detector stays unconfigured).
     fn reset(&mut self, _seed: u64) {
-        if self.scan < NS {
-            self.counts = [0; NS];
+        if self.scan < SCANS {
+            self.counts = [0; SCANS];
             self.ntracks = 0;
             self.scan = 0;
             self.period = None;
@@ -658,7 +688,7 @@ impl<const P: usize, const NS: usize, const R: usize, const A: usize, const T: u
             return None;
         }
         let t = self.tracks.get(i)?;
-        let n = self.cfg.n_scans.min(NS);
+        let n = self.cfg.n_scans.min(SCANS);
         let plot_of = |s: usize| {
             let k = *t.plots.get(s)?;
             if k == NO_PLOT {

@@ -5,8 +5,9 @@
 //! DBSCAN state extraction; the plain PHD-TBD and K-means extraction are the baselines.
 //!
 //! - [`smc_phd`]: the filter ([`SmcPhdTbd`], [`PhdConfig`], [`PhdReport`]).
-//! - [`pso`]: swarm, ENS-BS non-dominated sort (O(N) memory), weighted crowding.
-//! - [`ndsort`]: divide-and-conquer non-dominated sort for three or more objectives.
+//! - [`pso`]: swarm, weighted crowding, selection, mutation.
+//! - [`ndsort`]: non-dominated sorts: ENS-BS, and divide-and-conquer for three or more
+//!   objectives.
 //! - [`dbscan`]: grid-indexed DBSCAN.
 //! - [`kmeans`]: deterministic K-means.
 //! - the observation model lives in [`crate::model::power_cube`].
@@ -22,5 +23,6 @@ pub use kmeans::KMeans;
 pub use pso::{PsoConfig, Swarm, MAX_GENERATIONS};
 pub use smc_phd::{
     BirthComponent, BirthMode, BirthModel, Estimate, Extractor, PhdConfig, PhdReport, SmcPhdTbd,
-    MAX_BIRTH_COMPONENTS, MAX_INTENSITY, MAX_MUTATION, MAX_REGION_CELLS,
+    SmcPhdTbdHost, SmcPhdTbdM4, SmcPhdTbdSmall, SmcPhdTbdSoak, MAX_BIRTH_COMPONENTS, MAX_INTENSITY,
+    MAX_MUTATION, MAX_REGION_CELLS,
 };

@@ -1,14 +1,24 @@
-//! Divide-and-conquer non-dominated sorting for many objectives and large fronts
-//! (Jensen 2003, "Reducing the run-time complexity of multiobjective EAs: the NSGA-II and
-//! other algorithms", IEEE TEVC 7(5); with the tie handling of Fortin, Grenier, Parizeau
-//! 2013, "Generalizing the improved run-time complexity algorithm for non-dominated
-//! sorting", GECCO, and Buzdalov, Shalyto 2014, PPSN).
+//! Non-dominated sorting, exact and in O(N) memory (no N^2 domination lists), for the
+//! PSO step ([`super::pso`]), objectives **maximised**:
 //!
-//! ENS-BS ([`super::pso::non_dominated_sort`]) compares a solution with every member of a
+//! - [`non_dominated_sort`] (any number of objectives): ENS-BS (Zhang, Tian, Cheng, Jin,
+//!   "An efficient approach to nondominated sorting for evolutionary multiobjective
+//!   optimization", IEEE TEVC 2015): solutions are visited in lexicographic order (so
+//!   none can be dominated by a later one), and each is placed by binary search over the
+//!   fronts found so far, checking the members of a front newest first; fronts are
+//!   linked lists through one `next` array. Worst case O(M N^2); with at most two
+//!   objectives only the newest member of a front needs checking, O(N log N).
+//! - [`rank_sorted`]: divide-and-conquer sorting for many objectives and large fronts
+//!   (Jensen 2003, "Reducing the run-time complexity of multiobjective EAs: the NSGA-II and
+//!   other algorithms", IEEE TEVC 7(5); with the tie handling of Fortin, Grenier, Parizeau
+//!   2013, "Generalizing the improved run-time complexity algorithm for non-dominated
+//!   sorting", GECCO, and Buzdalov, Shalyto 2014, PPSN).
+//!
+//! ENS-BS ([`non_dominated_sort`]) compares a solution with every member of a
 //! front it is not dominated by, so a front of `F` members costs `O(N F)`; with three or
 //! more objectives the swarm's fronts hold most of a group (every particle inside the
 //! triangle of three points is non-dominated), measured ~640 of ~980 entries per group.
-//! This algorithm is `O(N log^(k-1) N)` whatever the front sizes, in `O(N)` memory
+//! [`rank_sorted`] is `O(N log^(k-1) N)` whatever the front sizes, in `O(N)` memory
 //! (four caller arrays, recursion depth `O(k log N)`), and gives the same ranks.
 //!
 //! Objectives are **maximised**. Solutions are addressed by their position `p` in the
@@ -27,6 +37,136 @@
 //!
 //! Every helper leaves its index lists in ascending position order on return (stable
 //! partitions, merged back), so sub-lists stay lexicographically sorted.
+
+use crate::sort;
+
+/// The end of a front's linked list in [`ens_bs`].
+const NONE: u32 = u32::MAX;
+
+/// `a` dominates `b` (maximisation): `a >= b` in every objective, `>` in at least one.
+#[inline]
+pub fn dominates(a: &[f32], b: &[f32]) -> bool {
+    let mut strict = false;
+    for (x, y) in a.iter().zip(b) {
+        if x < y {
+            return false;
+        }
+        strict |= x > y;
+    }
+    strict
+}
+
+/// Lexicographic "better first" order on objective vectors (descending).
+#[inline]
+fn lex_desc(a: &[f32], b: &[f32]) -> core::cmp::Ordering {
+    for (x, y) in a.iter().zip(b) {
+        match y.partial_cmp(x) {
+            Some(core::cmp::Ordering::Equal) | None => continue,
+            Some(o) => return o,
+        }
+    }
+    core::cmp::Ordering::Equal
+}
+
+/// ENS-BS non-dominated sort of `f[..n]` (first `m` objectives of each row, maximised).
+///
+/// Writes the front index (0 = non-dominated) of each solution into `rank[..n]` and
+/// returns the number of fronts. Workspace: `order`, `next`, `head` of length `>= n`.
+/// Objective values must be finite (NaN compares as "equal" and does not panic).
+/// With `m <= 2` only each front's newest member is checked (see `ens_bs`), so the
+/// sort is O(N log N) whatever the front sizes.
+pub fn non_dominated_sort<const OBJECTIVES: usize>(
+    f: &[[f32; OBJECTIVES]],
+    m: usize,
+    rank: &mut [u32],
+    order: &mut [u32],
+    next: &mut [u32],
+    head: &mut [u32],
+) -> usize {
+    let n = f
+        .len()
+        .min(rank.len())
+        .min(order.len())
+        .min(next.len())
+        .min(head.len());
+    let m = m.min(OBJECTIVES);
+    for (i, o) in order[..n].iter_mut().enumerate() {
+        *o = i as u32;
+    }
+    sort::sort_unstable_by(&mut order[..n], |&a, &b| {
+        match (f.get(a as usize), f.get(b as usize)) {
+            (Some(fa), Some(fb)) => lex_desc(&fa[..m], &fb[..m]),
+            _ => core::cmp::Ordering::Equal,
+        }
+        .then(a.cmp(&b))
+    });
+    ens_bs(&order[..n], m <= 2, rank, next, head, |a, b| {
+        match (f.get(a), f.get(b)) {
+            (Some(fa), Some(fb)) => dominates(&fa[..m], &fb[..m]),
+            _ => false,
+        }
+    })
+}
+
+/// Front assignment of ENS-BS. `order` lists solution ids best first in lexicographic
+/// order (so no solution is dominated by a later one); `dom(a, b)`: `a` dominates `b`.
+/// `rank` and `next` are indexed by solution id, `head[..order.len()]` by front; fronts
+/// are linked lists (newest first) through `next`. Returns the number of fronts.
+///
+/// `newest_only` (valid for at most two objectives): in lexicographic order the members
+/// of one front have non-increasing `f_1` and non-decreasing `f_2`, so a later solution
+/// is dominated by some member iff it is dominated by the newest one.
+pub(crate) fn ens_bs(
+    order: &[u32],
+    newest_only: bool,
+    rank: &mut [u32],
+    next: &mut [u32],
+    head: &mut [u32],
+    dom: impl Fn(usize, usize) -> bool,
+) -> usize {
+    let mut fronts = 0usize;
+    for &s in order {
+        let s = s as usize;
+        // Is s dominated by some member of front `j`?
+        let dominated_by = |j: usize, head: &[u32], next: &[u32]| {
+            let mut t = head.get(j).copied().unwrap_or(NONE);
+            while t != NONE {
+                if dom(t as usize, s) {
+                    return true;
+                }
+                if newest_only {
+                    return false;
+                }
+                t = next.get(t as usize).copied().unwrap_or(NONE);
+            }
+            false
+        };
+        // First front (lo) whose members do not dominate s; monotone in j.
+        let (mut lo, mut hi) = (0usize, fronts);
+        while lo < hi {
+            let mid = (lo + hi) / 2;
+            if dominated_by(mid, head, next) {
+                lo = mid + 1;
+            } else {
+                hi = mid;
+            }
+        }
+        if lo == fronts {
+            if let Some(h) = head.get_mut(fronts) {
+                *h = NONE;
+            }
+            fronts += 1;
+        }
+        if let (Some(h), Some(nx)) = (head.get_mut(lo), next.get_mut(s)) {
+            *nx = *h;
+            *h = s as u32;
+        }
+        if let Some(r) = rank.get_mut(s) {
+            *r = lo as u32;
+        }
+    }
+    fronts
+}
 
 /// Below this many pairs, `helper_b` compares all pairs; below this many solutions,
 /// `helper_a` does.

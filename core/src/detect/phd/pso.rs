@@ -1,27 +1,20 @@
 //! Multi-objective particle swarm step (Pei et al. 2019, §2.1 and §2.3 step 3) with the
-//! NSGA-II machinery: fast non-dominated sorting in O(N) memory, weighted crowding
-//! distance (eq. 10-12), elitist selection, the three-part mutation, the stop rule.
+//! NSGA-II machinery: weighted crowding distance (eq. 10-12), elitist selection, the
+//! three-part mutation, the stop rule; the non-dominated sorts live in [`super::ndsort`].
 //!
 //! All objectives are **maximised** (fitness values in `[0, 1]`).
 //!
-//! Non-dominated sorting, all exact and O(N) memory (no N^2 domination lists):
-//! - [`non_dominated_sort`] (public, any number of objectives) and the swarm's groups with
-//!   two active objectives: ENS-BS (Zhang, Tian, Cheng, Jin, "An efficient approach to
-//!   nondominated sorting for evolutionary multiobjective optimization", IEEE TEVC 2015):
-//!   solutions are visited in lexicographic order (so none can be dominated by a later
-//!   one), and each is placed by binary search over the fronts found so far, checking the
-//!   members of a front newest first; fronts are linked lists through one `next` array.
-//!   Worst case O(M N^2); with at most two objectives only the newest member of a front
-//!   needs checking, O(N log N).
-//! - the swarm's groups with three or four active objectives: the divide-and-conquer
-//!   sort of [`super::ndsort`], O(N log^(M-1) N) whatever the front sizes (ENS-BS spent
-//!   70 % of the frame there: those groups' first fronts hold most of their entries);
-//!   with five or more, ENS-BS again (the `log^(M-1) N` factor outgrows it).
+//! The swarm's groups are ranked, all exactly and in O(N) memory, by:
+//! - two active objectives: ENS-BS ([`super::ndsort::non_dominated_sort`]), O(N log N);
+//! - three or four: the divide-and-conquer sort ([`super::ndsort::rank_sorted`]),
+//!   O(N log^(M-1) N) whatever the front sizes (ENS-BS spent 70 % of the frame there:
+//!   those groups' first fronts hold most of their entries); with five or more, ENS-BS
+//!   again (the `log^(M-1) N` factor outgrows it);
 //! - one active objective: the best half by that objective (a selection, O(N)).
 
 #![allow(clippy::needless_range_loop)]
 
-use super::ndsort;
+use super::ndsort::{self, ens_bs};
 use crate::math;
 use crate::rng::Rng;
 use crate::sort;
@@ -37,19 +30,6 @@ pub const MAX_GENERATIONS: usize = 1000;
 /// more use ENS-BS, see [`Swarm::select`]).
 const DC_OBJECTIVES: usize = 4;
 
-/// `a` dominates `b` (maximisation): `a >= b` in every objective, `>` in at least one.
-#[inline]
-pub fn dominates(a: &[f32], b: &[f32]) -> bool {
-    let mut strict = false;
-    for (x, y) in a.iter().zip(b) {
-        if x < y {
-            return false;
-        }
-        strict |= x > y;
-    }
-    strict
-}
-
 /// `a[to] = a[from]` (nothing when either is out of range: never, for the callers).
 #[inline(always)]
 fn shift<T: Copy>(a: &mut [T], from: usize, to: usize) {
@@ -60,126 +40,14 @@ fn shift<T: Copy>(a: &mut [T], from: usize, to: usize) {
     }
 }
 
-/// Lexicographic "better first" order on objective vectors (descending).
-#[inline]
-fn lex_desc(a: &[f32], b: &[f32]) -> core::cmp::Ordering {
-    for (x, y) in a.iter().zip(b) {
-        match y.partial_cmp(x) {
-            Some(core::cmp::Ordering::Equal) | None => continue,
-            Some(o) => return o,
-        }
-    }
-    core::cmp::Ordering::Equal
-}
-
-/// ENS-BS non-dominated sort of `f[..n]` (first `m` objectives of each row, maximised).
-///
-/// Writes the front index (0 = non-dominated) of each solution into `rank[..n]` and
-/// returns the number of fronts. Workspace: `order`, `next`, `head` of length `>= n`.
-/// Objective values must be finite (NaN compares as "equal" and does not panic).
-/// With `m <= 2` only each front's newest member is checked (see `ens_bs`), so the
-/// sort is O(N log N) whatever the front sizes.
-pub fn non_dominated_sort<const M: usize>(
-    f: &[[f32; M]],
-    m: usize,
-    rank: &mut [u32],
-    order: &mut [u32],
-    next: &mut [u32],
-    head: &mut [u32],
-) -> usize {
-    let n = f
-        .len()
-        .min(rank.len())
-        .min(order.len())
-        .min(next.len())
-        .min(head.len());
-    let m = m.min(M);
-    for (i, o) in order[..n].iter_mut().enumerate() {
-        *o = i as u32;
-    }
-    sort::sort_unstable_by(&mut order[..n], |&a, &b| {
-        match (f.get(a as usize), f.get(b as usize)) {
-            (Some(fa), Some(fb)) => lex_desc(&fa[..m], &fb[..m]),
-            _ => core::cmp::Ordering::Equal,
-        }
-        .then(a.cmp(&b))
-    });
-    ens_bs(&order[..n], m <= 2, rank, next, head, |a, b| {
-        match (f.get(a), f.get(b)) {
-            (Some(fa), Some(fb)) => dominates(&fa[..m], &fb[..m]),
-            _ => false,
-        }
-    })
-}
-
-/// Front assignment of ENS-BS. `order` lists solution ids best first in lexicographic
-/// order (so no solution is dominated by a later one); `dom(a, b)`: `a` dominates `b`.
-/// `rank` and `next` are indexed by solution id, `head[..order.len()]` by front; fronts
-/// are linked lists (newest first) through `next`. Returns the number of fronts.
-///
-/// `newest_only` (valid for at most two objectives): in lexicographic order the members
-/// of one front have non-increasing `f_1` and non-decreasing `f_2`, so a later solution
-/// is dominated by some member iff it is dominated by the newest one.
-fn ens_bs(
-    order: &[u32],
-    newest_only: bool,
-    rank: &mut [u32],
-    next: &mut [u32],
-    head: &mut [u32],
-    dom: impl Fn(usize, usize) -> bool,
-) -> usize {
-    let mut fronts = 0usize;
-    for &s in order {
-        let s = s as usize;
-        // Is s dominated by some member of front `j`?
-        let dominated_by = |j: usize, head: &[u32], next: &[u32]| {
-            let mut t = head.get(j).copied().unwrap_or(NONE);
-            while t != NONE {
-                if dom(t as usize, s) {
-                    return true;
-                }
-                if newest_only {
-                    return false;
-                }
-                t = next.get(t as usize).copied().unwrap_or(NONE);
-            }
-            false
-        };
-        // First front (lo) whose members do not dominate s; monotone in j.
-        let (mut lo, mut hi) = (0usize, fronts);
-        while lo < hi {
-            let mid = (lo + hi) / 2;
-            if dominated_by(mid, head, next) {
-                lo = mid + 1;
-            } else {
-                hi = mid;
-            }
-        }
-        if lo == fronts {
-            if let Some(h) = head.get_mut(fronts) {
-                *h = NONE;
-            }
-            fronts += 1;
-        }
-        if let (Some(h), Some(nx)) = (head.get_mut(lo), next.get_mut(s)) {
-            *nx = *h;
-            *h = s as u32;
-        }
-        if let Some(r) = rank.get_mut(s) {
-            *r = lo as u32;
-        }
-    }
-    fronts
-}
-
 /// Weighted crowding distance (eq. 10-12): per front and objective `j`, sorted by
 /// `f_j`, the two ends get `boundary` and inner solutions get
 /// `sum_j W_j (f_j[next] - f_j[prev]) / (f_j,max - f_j,min)`. An objective on which the
 /// front has zero span adds nothing, not even boundaries (its "ends" would be arbitrary).
 ///
 /// `order` is a workspace of length `>= n`.
-pub fn crowding_distance<const M: usize>(
-    f: &[[f32; M]],
+pub fn crowding_distance<const OBJECTIVES: usize>(
+    f: &[[f32; OBJECTIVES]],
     m: usize,
     weights: &[f32],
     rank: &[u32],
@@ -188,7 +56,7 @@ pub fn crowding_distance<const M: usize>(
     order: &mut [u32],
 ) {
     let n = f.len().min(rank.len()).min(crowd.len()).min(order.len());
-    let m = m.min(M).min(weights.len());
+    let m = m.min(OBJECTIVES).min(weights.len());
     for c in crowd[..n].iter_mut() {
         *c = 0.0;
     }
@@ -291,7 +159,7 @@ pub struct PsoConfig {
     pub gate: f32,
     /// Half width (m) of the uniform mutation increments, at most `f32::MAX / 4`.
     pub mutation: f32,
-    /// Number of measurement-derived points `Z_m` (objectives), at most the capacity `M`.
+    /// Number of measurement-derived points `Z_m` (objectives), at most the capacity `POINTS`.
     pub points: usize,
     /// At most this many particles join the swarm per frame, evenly spaced in index
     /// order among the gated ones (`usize::MAX`: all of them); also bounded by the
@@ -327,38 +195,38 @@ impl PsoConfig {
     }
 }
 
-/// Swarm workspace for up to `S / 2` particles (parents plus children fill `S`) and `M`
-/// objectives. Memory is O(S M).
+/// Swarm workspace for up to `SWARM / 2` particles (parents plus children fill `SWARM`)
+/// and `POINTS` objectives (one per measurement point). Memory is O(SWARM POINTS).
 #[derive(Debug, Clone)]
-pub struct Swarm<const S: usize, const M: usize> {
+pub struct Swarm<const SWARM: usize, const POINTS: usize> {
     /// Position (x, y) per entry.
-    pub pos: [[f32; 2]; S],
-    vel: [[f32; 2]; S],
-    pbest: [[f32; 2]; S],
-    pbest_fit: [f32; S],
+    pub pos: [[f32; 2]; SWARM],
+    vel: [[f32; 2]; SWARM],
+    pbest: [[f32; 2]; SWARM],
+    pbest_fit: [f32; SWARM],
     /// Objective values per entry.
-    pub fit: [[f32; M]; S],
+    pub fit: [[f32; POINTS]; SWARM],
     /// PHD weight carried from parent to child.
-    pub weight: [f32; S],
+    pub weight: [f32; SWARM],
     /// Filter particle each entry descends from.
-    pub src: [u32; S],
+    pub src: [u32; SWARM],
     /// Selection group of each entry (the caller's target group; children inherit it).
-    group: [u16; S],
-    rank: [u32; S],
+    group: [u16; SWARM],
+    rank: [u32; SWARM],
     /// Crowding distance as `f32` bits (non-negative, so the bits order like the values);
     /// the divide-and-conquer sort's Fenwick tree while ranks are computed.
-    crowd: [u32; S],
-    order: [u32; S],
-    next: [u32; S],
-    head: [u32; S],
-    aux: [u32; S],
+    crowd: [u32; SWARM],
+    order: [u32; SWARM],
+    next: [u32; SWARM],
+    head: [u32; SWARM],
+    aux: [u32; SWARM],
     /// Sort keys `key << 32 | index` (a `u64` sort needs no lookups in the comparator).
-    keys: [u64; S],
-    kept: [bool; S],
+    keys: [u64; SWARM],
+    kept: [bool; SWARM],
     /// A group's active objectives by sorted position, for the divide-and-conquer sort
     /// (one contiguous load per value instead of two dependent ones: -7 % instructions
     /// per frame on the host, -3 % on the Cortex-M4F).
-    objs: [[f32; DC_OBJECTIVES]; S],
+    objs: [[f32; DC_OBJECTIVES]; SWARM],
     /// Active entries (parents) after [`Swarm::run`].
     pub len: usize,
 }
@@ -372,40 +240,40 @@ pub struct SwarmReport {
     pub mean_fitness: f32,
 }
 
-impl<const S: usize, const M: usize> Default for Swarm<S, M> {
+impl<const SWARM: usize, const POINTS: usize> Default for Swarm<SWARM, POINTS> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<const S: usize, const M: usize> Swarm<S, M> {
+impl<const SWARM: usize, const POINTS: usize> Swarm<SWARM, POINTS> {
     /// Zeroed workspace.
     pub const fn new() -> Self {
         Self {
-            pos: [[0.0; 2]; S],
-            vel: [[0.0; 2]; S],
-            pbest: [[0.0; 2]; S],
-            pbest_fit: [0.0; S],
-            fit: [[0.0; M]; S],
-            weight: [0.0; S],
-            src: [0; S],
-            group: [0; S],
-            rank: [0; S],
-            crowd: [0; S],
-            order: [0; S],
-            next: [0; S],
-            head: [0; S],
-            aux: [0; S],
-            keys: [0; S],
-            kept: [false; S],
-            objs: [[0.0; DC_OBJECTIVES]; S],
+            pos: [[0.0; 2]; SWARM],
+            vel: [[0.0; 2]; SWARM],
+            pbest: [[0.0; 2]; SWARM],
+            pbest_fit: [0.0; SWARM],
+            fit: [[0.0; POINTS]; SWARM],
+            weight: [0.0; SWARM],
+            src: [0; SWARM],
+            group: [0; SWARM],
+            rank: [0; SWARM],
+            crowd: [0; SWARM],
+            order: [0; SWARM],
+            next: [0; SWARM],
+            head: [0; SWARM],
+            aux: [0; SWARM],
+            keys: [0; SWARM],
+            kept: [false; SWARM],
+            objs: [[0.0; DC_OBJECTIVES]; SWARM],
             len: 0,
         }
     }
 
     /// Parent capacity `S / 2`.
     pub const fn capacity() -> usize {
-        S / 2
+        SWARM / 2
     }
 
     /// Clears the swarm.
@@ -418,7 +286,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     /// The elitist selection keeps, per group, as many entries as the group had parents:
     /// the swarm moves particles, it must not move them between the PHD's targets.
     pub fn push(&mut self, pos: [f32; 2], weight: f32, src: u32, group: u16) -> bool {
-        if self.len >= S / 2 {
+        if self.len >= SWARM / 2 {
             return false;
         }
         let i = self.len;
@@ -458,7 +326,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             total += v;
         }
         if !points.is_empty() {
-            total /= points.len().min(M) as f32;
+            total /= points.len().min(POINTS) as f32;
         }
         if total > *best_fit {
             *best_fit = total;
@@ -474,7 +342,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
         let Some(fit) = self.fit.get(i) else {
             return best;
         };
-        for (j, &v) in fit[..m.min(M)].iter().enumerate() {
+        for (j, &v) in fit[..m.min(POINTS)].iter().enumerate() {
             if v > best.1 {
                 best = (j, v);
             }
@@ -494,8 +362,8 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     /// then lower index), which is always on the first front.
     pub fn run(&mut self, cfg: &PsoConfig, points: &[[f32; 2]], rng: &mut Rng) -> SwarmReport {
         // `push` keeps `len <= S / 2`; `len` is public.
-        let n = self.len.min(S / 2);
-        let m = points.len().min(M);
+        let n = self.len.min(SWARM / 2);
+        let m = points.len().min(POINTS);
         if n == 0 || m == 0 {
             return SwarmReport::default();
         }
@@ -512,8 +380,8 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
         let cap = cfg.max_generations.max(cfg.generations);
         while gens < cap && (gens < cfg.generations || mean_best < cfg.threshold) {
             gens += 1;
-            let mut leader = [0usize; M];
-            let mut lval = [(f32::NEG_INFINITY, f32::NEG_INFINITY); M];
+            let mut leader = [0usize; POINTS];
+            let mut lval = [(f32::NEG_INFINITY, f32::NEG_INFINITY); POINTS];
             for i in 0..n {
                 let mut tot = 0.0f32;
                 for j in 0..m {
@@ -533,7 +401,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             ];
             for i in 0..n {
                 let c = n + i;
-                if c >= S {
+                if c >= SWARM {
                     break;
                 }
                 let g = leader
@@ -575,7 +443,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             // Compact the kept entries in ascending index order (safe forward copy).
             let mut k = 0usize;
             mean_best = 0.0;
-            for s in 0..(2 * n).min(S) {
+            for s in 0..(2 * n).min(SWARM) {
                 if !self.kept[s] {
                     continue;
                 }
@@ -619,12 +487,12 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
     /// ENS-BS checking every front member. Only the front that is cut gets
     /// crowding distances (NSGA-II), since the fronts before it are kept whole.
     fn select(&mut self, tot: usize, m: usize, obj_w: f32) {
-        let tot = tot.min(S);
-        let m = m.min(M);
+        let tot = tot.min(SWARM);
+        let m = m.min(POINTS);
         // Counting sort of the entries by group into `order`.
-        let mut start = [0usize; M];
+        let mut start = [0usize; POINTS];
         for &g in self.group.iter().take(tot) {
-            start[(g as usize).min(M - 1)] += 1;
+            start[(g as usize).min(POINTS - 1)] += 1;
         }
         let mut acc = 0usize;
         for c in start.iter_mut() {
@@ -634,9 +502,9 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
         }
         let mut end = start;
         // Active objectives per group: some member has the objective above the gate.
-        let mut active = [[false; M]; M];
+        let mut active = [[false; POINTS]; POINTS];
         for i in 0..tot {
-            let g = (self.group[i] as usize).min(M - 1);
+            let g = (self.group[i] as usize).min(POINTS - 1);
             if let Some(o) = self.order.get_mut(end[g]) {
                 *o = i as u32;
             }
@@ -646,7 +514,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
                 *a |= v > 0.0;
             }
         }
-        for g in 0..M {
+        for g in 0..POINTS {
             let (s, e) = (start[g], end[g]);
             let keep = (e - s) / 2;
             if keep == 0 {
@@ -655,7 +523,7 @@ impl<const S: usize, const M: usize> Swarm<S, M> {
             // Active objectives of the group, the group's own point first (any objective
             // order gives the same fronts; with its own point first, whose fitness few
             // members lack, the lexicographic sort rarely needs a second objective).
-            let mut act = [0usize; M];
+            let mut act = [0usize; POINTS];
             let mut na = 0usize;
             if g < m && active[g][g] {
                 act[0] = g;

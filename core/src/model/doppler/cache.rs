@@ -26,15 +26,20 @@ pub struct ProjectionCache {
 
 impl Default for ProjectionCache {
     fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl ProjectionCache {
+    /// An empty cache (all zero, so a `static` of it lands in `.bss`).
+    pub const fn new() -> Self {
         Self {
             sums: [[0.0; 4]; CACHE_LEN],
             tag: [0; CACHE_LEN],
             cur: 0,
         }
     }
-}
 
-impl ProjectionCache {
     /// Invalidates every entry (call once per new frame).
     pub fn new_frame(&mut self) {
         self.cur += 1;

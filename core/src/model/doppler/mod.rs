@@ -63,13 +63,18 @@ pub use whiten::{unwindow, Likelihood, Whitener, MIN_WINDOW_COEFFICIENT};
 
 use crate::{Complex32, Error, Result};
 
-/// Validates a frame: `m` bins, all finite ([`Error::NonFinite`]), with a finite energy
-/// ([`Error::Overflow`]). Returns `||z||^2`.
+/// Validates a frame: `m` bins ([`Error::LengthMismatch`]; `m = 0`, e.g. an
+/// unconfigured detector's, is [`Error::InvalidConfig`]), all finite
+/// ([`Error::NonFinite`]), with a finite energy ([`Error::Overflow`]). Returns `||z||^2`.
 pub fn check_frame(z: &[Complex32], m: usize) -> Result<f32> {
-    if z.len() != m {
-        return Err(Error::LengthMismatch {
-            expected: m,
-            got: z.len(),
+    if z.len() != m || m == 0 {
+        return Err(if m == 0 {
+            Error::InvalidConfig("bins per frame = 0")
+        } else {
+            Error::LengthMismatch {
+                expected: m,
+                got: z.len(),
+            }
         });
     }
     let mut zz = 0.0f32;

@@ -9,6 +9,7 @@ use faint_core::model::range_doppler::{quantise, Dequant, PointModel};
 use faint_core::rng::{derive_seed, Rng};
 use serde::Serialize;
 
+use crate::instances::boxed;
 use crate::instances::cbmember::{HostFilter, HostFilterU8};
 use crate::montecarlo::run_trials;
 use crate::simulate::cbmember::{MapSource, RotorUav};
@@ -86,8 +87,8 @@ fn one_run(sc: &RotorUav, filters: &[FilterSpec], rng: &mut Rng) -> Result<Vec<R
         let seed = rng.fork(10 + k as u64).next_u64();
         let e = |e| anyhow::anyhow!("{}: {e}", f.name);
         match f.input {
-            Input::Power => power.push(Box::new(HostFilter::new(f.cfg, seed).map_err(e)?)),
-            Input::Quantised => quant.push(Box::new(HostFilterU8::new(f.cfg, seed).map_err(e)?)),
+            Input::Power => power.push(boxed::<HostFilter>(&f.cfg, seed).map_err(e)?),
+            Input::Quantised => quant.push(boxed::<HostFilterU8>(&f.cfg, seed).map_err(e)?),
         }
     }
     let dq = Dequant::new(sc.filter.noise_var, sc.filter.quant_step);

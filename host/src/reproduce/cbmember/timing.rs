@@ -51,10 +51,7 @@ pub(super) fn timing(frames: usize, seed: u64) -> Result<Vec<TimingRow>> {
     ] {
         let mut rng = Rng::from_stream(seed, 77);
         let mut src = MapSource::new(&sc);
-        let mut f = Box::new(
-            HostFilter::new(sc.config(model, particles), seed)
-                .map_err(|e| anyhow::anyhow!("{e}"))?,
-        );
+        let mut f = crate::instances::boxed::<HostFilter>(&sc.config(model, particles), seed)?;
         let mut map = Vec::new();
         let mut secs = 0.0;
         let mut parts = 0usize;

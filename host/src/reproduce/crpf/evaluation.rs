@@ -4,8 +4,8 @@
 //! Fig. 5 parameter sweeps.
 
 use anyhow::{bail, Result};
-use faint_core::detect::bernoulli::BernoulliTbd;
 use faint_core::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint_core::detect::jott::JottTbd;
 use faint_core::detect::pf_lrt::PfLrt;
 use faint_core::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint_core::detect::Detector;
@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use super::args::Settings;
 use super::comparators::{ComparatorModel, Comparators, Likelihood, VarSource};
+use crate::instances::boxed;
 use crate::montecarlo::run_trial_range;
 use crate::simulate::crpf::{Noise, Othr, Run};
 use crate::stats::detection::{detection_rate, snr_at_pd, threshold_at_pfa, PdPoint};
@@ -145,7 +146,7 @@ fn stats_of<const N: usize>(
     seed: u64,
     comparators: Comparators,
 ) -> Result<Stats> {
-    let mut crpf = Box::new(CrpfTbd::<N>::new(*crpf_cfg, derive_seed(seed, 1))?);
+    let mut crpf = boxed::<CrpfTbd<N>>(crpf_cfg, derive_seed(seed, 1))?;
     let rc = run_detector(crpf.as_mut(), run)?;
     let pe: Vec<f32> = rc.iter().map(|r| r.existence).collect();
     let mut st = Stats {
@@ -158,19 +159,19 @@ fn stats_of<const N: usize>(
         return Ok(st);
     };
     let g = comparator_config(run, crpf_cfg.model, &cm)?;
-    let mut pf = Box::new(PfTbd::<N>::new(g, derive_seed(seed, 2))?);
+    let mut pf = boxed::<PfTbd<N>>(&g, derive_seed(seed, 2))?;
     let rp: Vec<f32> = run_detector(pf.as_mut(), run)?
         .iter()
         .map(|r| r.existence)
         .collect();
     drop(pf);
-    let mut jott = Box::new(BernoulliTbd::<N>::new(g, derive_seed(seed, 3))?);
+    let mut jott = boxed::<JottTbd<N>>(&g, derive_seed(seed, 3))?;
     let rj: Vec<f32> = run_detector(jott.as_mut(), run)?
         .iter()
         .map(|r| r.existence)
         .collect();
     drop(jott);
-    let mut lrt = Box::new(PfLrt::<N>::new(g, derive_seed(seed, 4))?);
+    let mut lrt = boxed::<PfLrt<N>>(&g, derive_seed(seed, 4))?;
     let rl = run_detector(lrt.as_mut(), run)?;
     st.pf_mean = d_k(&rp)? as f64;
     st.pf_max = zeta_k(&rp)? as f64;

@@ -17,12 +17,12 @@ pub fn detectors(
     cfg.gate = sc.v_max * sc.t_scan;
     cfg.along_gate = cfg.gate;
     cfg.gamma1 = gamma1;
-    let mht = Box::new(Mht::new(cfg).map_err(|e| anyhow::anyhow!("{e}"))?);
+    let mht = crate::instances::boxed::<Mht>(&cfg, 0)?;
     let ccfg = ClassicHoughConfig {
         area: sc.area,
         n_scans: sc.n_scans,
         gamma: gamma_classic,
     };
-    let classic = Box::new(Classic::new(ccfg).map_err(|e| anyhow::anyhow!("{e}"))?);
+    let classic = crate::instances::boxed::<Classic>(&ccfg, 0)?;
     Ok((mht, classic))
 }

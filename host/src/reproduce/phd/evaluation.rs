@@ -65,9 +65,7 @@ fn one_run(sc: &SixTargets, variants: &[Variant], seed_rng: &mut Rng) -> Result<
         // keep the seeds of earlier runs whatever `--variants` selects).
         let i = Variant::EVERY.iter().position(|&x| x == v).unwrap_or(0);
         let seed = seed_rng.fork(10 + i as u64).next_u64();
-        filters.push(Box::new(
-            HostFilter::new(sc.config(v), seed).map_err(|e| anyhow::anyhow!("{e}"))?,
-        ));
+        filters.push(crate::instances::boxed::<HostFilter>(&sc.config(v), seed)?);
     }
     let mut res = vec![
         RunResult {

@@ -89,11 +89,13 @@ pub struct BirthModel {
     pub intensity: [f32; 2],
 }
 
-impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N, S, M, K> {
+impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARGETS: usize>
+    SmcPhdTbd<PARTICLES, SWARM, POINTS, TARGETS>
+{
     pub(super) fn add_births(&mut self) {
         let b = self.cfg.birth;
         let g = self.cfg.geometry;
-        let j = b.particles.min(N - self.n);
+        let j = b.particles.min(PARTICLES - self.n);
         if j == 0 {
             return;
         }

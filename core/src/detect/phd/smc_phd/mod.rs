@@ -32,6 +32,7 @@ pub use birth::{
 use super::dbscan::{Dbscan, DbscanParams};
 use super::kmeans::KMeans;
 use super::pso::{PsoConfig, Swarm};
+use crate::detect::interface::unconfigured_is_zero;
 use crate::detect::{Detection, Detector, ScoreKind, Validate};
 use crate::math::{self, KahanSum};
 use crate::model::power_cube::{
@@ -225,7 +226,7 @@ pub struct Estimate {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct PhdReport {
-    /// `N_hat = round(sum w)`, capped at the capacity `K`.
+    /// `N_hat = round(sum w)`, capped at the capacity `TARGETS`.
     pub n_hat: usize,
     /// Posterior PHD mass `sum w`.
     pub mass: f32,
@@ -237,7 +238,7 @@ pub struct PhdReport {
     pub swarm: usize,
     /// Swarm generations run.
     pub pso_generations: usize,
-    /// `round(sum w)` exceeded `K` and was capped (documented recovery).
+    /// `round(sum w)` exceeded `TARGETS` and was capped (documented recovery).
     pub truncated: bool,
     /// Every weight underflowed to zero: the PHD is emptied and refilled by the next
     /// frame's births (documented recovery).
@@ -248,33 +249,48 @@ pub struct PhdReport {
     pub extract_failed: bool,
 }
 
-/// The SMC-PHD TBD filter with capacities: `N` particles (survivors plus births), `S`
-/// swarm entries (parents plus children, so up to `S / 2` particles move), `M`
-/// measurement points (PSO objectives), `K` extracted targets.
+/// The firmware's filter (with its cube window it fits 1 MiB of RAM): 6144 particles,
+/// a 1024-entry swarm, 8 points, 8 targets.
+pub type SmcPhdTbdM4 = SmcPhdTbd<6144, 1024, 8, 8>;
+/// The host's filter: 8192 particles, a 16384-entry swarm, 10 points, 16 targets.
+pub type SmcPhdTbdHost = SmcPhdTbd<8192, 16384, 10, 16>;
+/// The golden case's filter: 256 particles, a 256-entry swarm, 4 points, 4 targets.
+pub type SmcPhdTbdSmall = SmcPhdTbd<256, 256, 4, 4>;
+/// The soak run's filter: 1024 particles, a 64-entry swarm, 8 points, 16 targets.
+pub type SmcPhdTbdSoak = SmcPhdTbd<1024, 64, 8, 16>;
+
+/// The SMC-PHD TBD filter with capacities: `PARTICLES` (survivors plus births), `SWARM`
+/// entries (parents plus children, so up to `SWARM / 2` particles move), `POINTS`
+/// measurement points (PSO objectives), `TARGETS` extracted targets.
 ///
-/// Memory: about `123 N + (64 + 4 M) S` bytes (32-bit target; e.g. 897 KB at
-/// `N = S = 4096, M = 8`): build large instances in a `Box`, or zeroed in a `static` and
-/// set up by [`Detector::configure`].
+/// Memory: about `123 N + (64 + 4 M) S` bytes with `N = PARTICLES`, `M = POINTS`,
+/// `S = SWARM` (32-bit target; e.g. 897 KB at `N = S = 4096, M = 8`): build large instances in a `Box` or a `static` from
+/// [`SmcPhdTbd::new_unconfigured`] and set up by [`Detector::configure`].
 #[derive(Debug, Clone)]
-pub struct SmcPhdTbd<const N: usize, const S: usize, const M: usize, const K: usize> {
+pub struct SmcPhdTbd<
+    const PARTICLES: usize,
+    const SWARM: usize,
+    const POINTS: usize,
+    const TARGETS: usize,
+> {
     cfg: PhdConfig,
-    x: [[f32; 5]; N],
-    w: [f32; N],
+    x: [[f32; 5]; PARTICLES],
+    w: [f32; PARTICLES],
     n: usize,
-    scratch: [[f32; 5]; N],
-    lw: [f32; N],
-    key: [u32; N],
-    order: [u32; N],
-    anc: [u32; N],
-    run_key: [u32; N],
-    parent: [u32; N],
-    pts: [[f32; 2]; N],
-    swarm: Swarm<S, M>,
-    dbscan: Dbscan<N>,
-    kmeans: KMeans<N, K>,
-    est: [Estimate; K],
+    scratch: [[f32; 5]; PARTICLES],
+    lw: [f32; PARTICLES],
+    key: [u32; PARTICLES],
+    order: [u32; PARTICLES],
+    anc: [u32; PARTICLES],
+    run_key: [u32; PARTICLES],
+    parent: [u32; PARTICLES],
+    pts: [[f32; 2]; PARTICLES],
+    swarm: Swarm<SWARM, POINTS>,
+    dbscan: Dbscan<PARTICLES>,
+    kmeans: KMeans<PARTICLES, TARGETS>,
+    est: [Estimate; TARGETS],
     n_est: usize,
-    zpts: [[f32; 2]; M],
+    zpts: [[f32; 2]; POINTS],
     n_z: usize,
     rng: Rng,
     /// Measurement-driven birth cells chosen on the previous frame, per component.
@@ -287,30 +303,40 @@ pub struct SmcPhdTbd<const N: usize, const S: usize, const M: usize, const K: us
     region_nb: usize,
 }
 
-impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N, S, M, K> {
+impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARGETS: usize>
+    SmcPhdTbd<PARTICLES, SWARM, POINTS, TARGETS>
+{
+    /// The unconfigured filter (a compile-time constant, [`Detector::UNCONFIGURED`]):
+    /// every call but [`Detector::configure`] returns a typed error or nothing until a
+    /// configuration succeeds. For a `static` or a `Box`.
+    pub const fn new_unconfigured() -> Self {
+        <Self as Detector>::UNCONFIGURED
+    }
+
     /// A filter with an empty PHD (the first frame's births populate it).
-    /// Errors: invalid config, `J >= N`, more PSO points than `M`, `K == 0`.
+    /// Errors: invalid config, `J >= PARTICLES`, more PSO points than `POINTS`,
+    /// `TARGETS == 0`.
     pub fn new(cfg: PhdConfig, seed: u64) -> Result<Self> {
         Self::check(&cfg)?;
         Ok(Self {
             cfg,
-            x: [[0.0; 5]; N],
-            w: [0.0; N],
+            x: [[0.0; 5]; PARTICLES],
+            w: [0.0; PARTICLES],
             n: 0,
-            scratch: [[0.0; 5]; N],
-            lw: [0.0; N],
-            key: [0; N],
-            order: [0; N],
-            anc: [0; N],
-            run_key: [0; N],
-            parent: [0; N],
-            pts: [[0.0; 2]; N],
+            scratch: [[0.0; 5]; PARTICLES],
+            lw: [0.0; PARTICLES],
+            key: [0; PARTICLES],
+            order: [0; PARTICLES],
+            anc: [0; PARTICLES],
+            run_key: [0; PARTICLES],
+            parent: [0; PARTICLES],
+            pts: [[0.0; 2]; PARTICLES],
             swarm: Swarm::new(),
             dbscan: Dbscan::new(),
             kmeans: KMeans::new(),
-            est: [Estimate::default(); K],
+            est: [Estimate::default(); TARGETS],
             n_est: 0,
-            zpts: [[0.0; 2]; M],
+            zpts: [[0.0; 2]; POINTS],
             n_z: 0,
             rng: Rng::seed_from_u64(seed),
             birth_cells: [[(0, 0.0); MAX_BIRTH_CELLS]; MAX_BIRTH_COMPONENTS],
@@ -323,19 +349,19 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
 
     fn check(cfg: &PhdConfig) -> Result<()> {
         cfg.validate()?;
-        if K == 0 || N < 2 || N > u32::MAX as usize {
+        if TARGETS == 0 || PARTICLES < 2 || PARTICLES > u32::MAX as usize {
             return Err(Error::InvalidConfig("capacities"));
         }
-        if cfg.birth.particles >= N {
+        if cfg.birth.particles >= PARTICLES {
             return Err(Error::Capacity {
-                capacity: N - 1,
+                capacity: PARTICLES - 1,
                 requested: cfg.birth.particles,
             });
         }
         if let Some(p) = &cfg.pso {
-            if p.points > M {
+            if p.points > POINTS {
                 return Err(Error::Capacity {
-                    capacity: M,
+                    capacity: POINTS,
                     requested: p.points,
                 });
             }
@@ -402,8 +428,8 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         } else {
             0
         };
-        report.truncated = nh > K;
-        report.n_hat = nh.min(K);
+        report.truncated = nh > TARGETS;
+        report.n_hat = nh.min(TARGETS);
         if !(mass.is_finite() && mass > 0.0 && self.resample(report.n_hat, mass)) {
             report.degenerate = true;
             report.mass = 0.0;
@@ -443,19 +469,21 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
     }
 }
 
-impl<const N: usize, const S: usize, const M: usize, const K: usize> Detector
-    for SmcPhdTbd<N, S, M, K>
+impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARGETS: usize> Detector
+    for SmcPhdTbd<PARTICLES, SWARM, POINTS, TARGETS>
 {
     type Frame = [f32];
     type Config = PhdConfig;
     type Report = PhdReport;
     const STATE: &'static [&'static str] = &["x_m", "vx_m_per_s", "y_m", "vy_m_per_s", "intensity"];
     const SCORE: ScoreKind = ScoreKind::Mass;
+    unconfigured_is_zero!();
 
     /// Re-validates `cfg` and restarts in place from `seed`, behaving exactly as
     /// [`SmcPhdTbd::new`]`(cfg, seed)` would, without building the (large) filter by
-    /// value: how one that lives in a `static` is set up, including from the all-zero
-    /// value (e.g. the firmware's `.bss` detectors). On error `self` is unchanged.
+    /// value: how one that lives in a `static` is set up, from
+    /// [`SmcPhdTbd::new_unconfigured`] (e.g. the firmware's `.bss` detectors). On error
+    /// `self` is unchanged.
     fn configure(&mut self, cfg: &PhdConfig, seed: u64) -> Result<()> {
         Self::check(cfg)?;
         self.cfg = *cfg;

@@ -4,11 +4,13 @@
 
 use super::*;
 
-impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N, S, M, K> {
+impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARGETS: usize>
+    SmcPhdTbd<PARTICLES, SWARM, POINTS, TARGETS>
+{
     pub(super) fn select_points(&mut self, cube: &PowerCube<'_>, n_surv: usize, want: usize) {
         let g = *cube.geometry();
         let data = cube.data();
-        let want = want.min(M);
+        let want = want.min(POINTS);
         // The statistic over at most 3 x 3 x 3 cells (`PointSpread::central`), the
         // thinning over the spread's own peak radius.
         let rad = [
@@ -18,8 +20,8 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         ];
         let psf = self.cfg.psf.central();
         // (z, ir, lb, jd) sorted descending by z.
-        let mut top = [(0.0f32, 0usize, 0usize, 0usize); M];
-        let mut amp = [0.0f32; M];
+        let mut top = [(0.0f32, 0usize, 0usize, 0usize); POINTS];
+        let mut amp = [0.0f32; POINTS];
         let mut nt = 0usize;
         let mut last_cell = usize::MAX;
         if want == 0 {
@@ -69,7 +71,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             }
             // Drop weaker neighbours, then insert.
             let mut k = 0;
-            for t in 0..nt.min(M) {
+            for t in 0..nt.min(POINTS) {
                 if !near(&top[t]) {
                     // k <= t
                     if k < t {
@@ -159,7 +161,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
 
     /// The swarm over at most `pso.max_members` of the gated particles.
     pub(super) fn swarm_step(&mut self, pso: &PsoConfig) -> (usize, usize) {
-        let m = self.n_z.min(M);
+        let m = self.n_z.min(POINTS);
         if m == 0 {
             return (0, 0);
         }
@@ -191,8 +193,10 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
         }
         // At most `max_members` of them (and the swarm's capacity), evenly spaced:
         // member `j` is gated particle `floor(j gated / take)`.
-        let take = gated.min(pso.max_members).min(Swarm::<S, M>::capacity());
-        let mut before = [0.0f32; M];
+        let take = gated
+            .min(pso.max_members)
+            .min(Swarm::<SWARM, POINTS>::capacity());
+        let mut before = [0.0f32; POINTS];
         let mut n_s = 0usize;
         for j in 0..take {
             let g = (j as u64 * gated as u64 / take as u64) as usize;
@@ -219,8 +223,8 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             return (0, 0);
         }
         let rep = self.swarm.run(pso, zpts, &mut self.rng);
-        let n_s = n_s.min(S);
-        let mut after = [0.0f32; M];
+        let n_s = n_s.min(SWARM);
+        let mut after = [0.0f32; POINTS];
         for k in 0..n_s {
             let (g, _) = nearest(self.swarm.pos[k], zpts);
             if let Some(a) = after.get_mut(g) {
@@ -228,7 +232,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             }
         }
 
-        let mut scale = [1.0f32; M];
+        let mut scale = [1.0f32; POINTS];
         for g in 0..m {
             if after[g] > 0.0 {
                 scale[g] = before[g] / after[g];

@@ -37,13 +37,15 @@ fn find(parent: &mut [u32], mut r: usize) -> usize {
     r
 }
 
-impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N, S, M, K> {
+impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARGETS: usize>
+    SmcPhdTbd<PARTICLES, SWARM, POINTS, TARGETS>
+{
     /// Weight update of eq. 20/24-25; returns `sum w`.
     pub(super) fn update(&mut self, cube: &PowerCube<'_>) -> f32 {
         let g = *cube.geometry();
         let psf = self.cfg.psf;
         let s2 = self.cfg.noise_var;
-        let n = self.n.min(N);
+        let n = self.n.min(PARTICLES);
         for i in 0..n {
             let s = self.x[i];
             let c = RadarCoords::from_state(s[0], s[1], s[2], s[3]);
@@ -98,7 +100,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
             }
             s = e.max(s + 1);
         }
-        let nr = nr.min(N);
+        let nr = nr.min(PARTICLES);
         // Merge runs whose cells touch (|d| <= 1 on every axis): one target's energy
         // spreads over neighbouring cells, and particles attributed to either are one
         // "resolution cell" for the normalisation of eq. 20 (else every neighbour cell
@@ -173,7 +175,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
     }
 
     pub(super) fn resample(&mut self, n_hat: usize, mass: f32) -> bool {
-        let cap = N - self.cfg.birth.particles;
+        let cap = PARTICLES - self.cfg.birth.particles;
         let l = self
             .cfg
             .particles_per_target
@@ -207,7 +209,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
 
     pub(super) fn extract(&mut self, n_hat: usize) -> Result<()> {
         self.n_est = 0;
-        let n = self.n.min(N);
+        let n = self.n.min(PARTICLES);
         if n_hat == 0 || n == 0 {
             return Ok(());
         }
@@ -219,7 +221,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                 let x = &self.x;
                 let est = &mut self.est;
                 let n_est = &mut self.n_est;
-                let want = n_hat.min(K);
+                let want = n_hat.min(TARGETS);
                 self.dbscan.run(&self.pts[..n], &p, |members| {
                     let size = members.len() as u32;
                     if *n_est == want && est[want - 1].support >= size {
@@ -254,7 +256,7 @@ impl<const N: usize, const S: usize, const M: usize, const K: usize> SmcPhdTbd<N
                 let k = self
                     .kmeans
                     .run(&self.pts[..n], n_hat, max_iter, &mut self.rng)?;
-                let mut acc = [[0.0f32; 5]; K];
+                let mut acc = [[0.0f32; 5]; TARGETS];
                 for i in 0..n {
                     let c = self.kmeans.assign[i] as usize;
                     if let Some(a) = acc.get_mut(c).filter(|_| c < k) {

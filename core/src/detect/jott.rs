@@ -27,20 +27,25 @@ use crate::math;
 use crate::model::doppler::DopplerReport;
 use crate::{Complex32, Result};
 
-/// Bernoulli (JOTT) filter with `N` particles.
+/// JOTT with 1000 particles (the firmware's comparators, the host's default).
+pub type JottTbd1000 = JottTbd<1000>;
+/// JOTT with 6000 particles (the paper's count; the host's largest).
+pub type JottTbd6000 = JottTbd<6000>;
+
+/// JOTT (Bernoulli) filter with `PARTICLES` particles.
 #[derive(Debug, Clone)]
-pub struct BernoulliTbd<const N: usize> {
-    cloud: GaussianCloud<[f32; 3], N>,
+pub struct JottTbd<const PARTICLES: usize> {
+    cloud: GaussianCloud<[f32; 3], PARTICLES>,
     q: f32,
 }
 
 gauss_detector!(
-    BernoulliTbd { q: 0.0 },
+    JottTbd { q: 0.0 },
     "Validates `cfg`; `q_0 = initial_existence`, particles from `U(I_x0)`.",
     crate::detect::ScoreKind::Existence
 );
 
-impl<const N: usize> BernoulliTbd<N> {
+impl<const PARTICLES: usize> JottTbd<PARTICLES> {
     /// One frame (the `Detector::step` of this detector).
     fn advance(&mut self, z: &[Complex32]) -> Result<DopplerReport> {
         let chain = &self.cloud.model().chain;
@@ -53,7 +58,7 @@ impl<const N: usize> BernoulliTbd<N> {
         };
         let first = self.cloud.frame() == 0;
         // Validated at configuration: `None` is the exact proposal.
-        let fixed = match self.cloud.config().birth.birth_count::<N>() {
+        let fixed = match self.cloud.config().birth.birth_count::<PARTICLES>() {
             Ok(Some(b)) if !first => Some(b),
             _ => None,
         };
@@ -67,7 +72,7 @@ impl<const N: usize> BernoulliTbd<N> {
                 let ln_t = math::ln(total);
                 (
                     log_mass(born_mass) - math::ln(b as f32) - ln_t,
-                    log_mass(persist_mass) - math::ln((N as u32 - b) as f32) - ln_t,
+                    log_mass(persist_mass) - math::ln((PARTICLES as u32 - b) as f32) - ln_t,
                 )
             } else {
                 (0.0, 0.0)
@@ -97,7 +102,7 @@ impl<const N: usize> BernoulliTbd<N> {
         let ln_v = if fixed.is_some() {
             0.0
         } else {
-            math::ln(N as f32)
+            math::ln(PARTICLES as f32)
         };
         let q = match self.cloud.normalise() {
             Some(lse) => {
