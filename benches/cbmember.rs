@@ -8,10 +8,10 @@
 //! `cargo bench --bench cbmember -- --warm-up-time 1 --measurement-time 5`
 
 use criterion::{criterion_group, BatchSize, Criterion};
-use faint::core::detect::cbmember::Likelihood;
-use faint::core::detect::Detector;
-use faint::core::model::range_doppler::{quantise, Dequant, PointModel};
-use faint::core::rng::Rng;
+use faint::detect::cbmember::Likelihood;
+use faint::detect::Detector;
+use faint::model::range_doppler::{quantise, Dequant, PointModel};
+use faint::rng::Rng;
 use faint::host::instances::boxed;
 use faint::host::instances::cbmember::{HostFilter, HostFilterU8};
 use faint::host::simulate::cbmember::{MapSource, RotorUav};

@@ -5,14 +5,14 @@
 //! N = 6000 (78 ms per frame). Goal: CRPF-TBD N = 6000 under 0.5 ms per frame.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
-use faint::core::detect::jott::JottTbd;
-use faint::core::detect::pf_lrt::PfLrt;
-use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint::core::detect::{run, Detector};
-use faint::core::model::doppler::{estimate_noise_variance, DopplerReport};
-use faint::core::rng::Rng;
-use faint::core::Complex32;
+use faint::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint::detect::jott::JottTbd;
+use faint::detect::pf_lrt::PfLrt;
+use faint::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint::detect::{run, Detector};
+use faint::model::doppler::{estimate_noise_variance, DopplerReport};
+use faint::rng::Rng;
+use faint::Complex32;
 use faint::host::instances::boxed;
 use faint::host::simulate::crpf::{Noise, Othr};
 use std::hint::black_box;

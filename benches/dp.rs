@@ -10,9 +10,9 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use faint::core::detect::dp::{DpConfig, DpTrack, Method};
-use faint::core::dp_tbd;
-use faint::core::rng::Rng;
+use faint::detect::dp::{DpConfig, DpTrack, Method};
+use faint::dp_tbd;
+use faint::rng::Rng;
 
 const M: usize = 128;
 const L: usize = 8;

@@ -2,9 +2,9 @@
 //! DMHT + smoothing + peaks + association), the classic detector per period, and the
 //! f32 vs fixed-point rho quantiser, at lambda = 80 and 398 (sea-clutter preset).
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
-use faint::core::detect::mht::Geometry;
-use faint::core::detect::Detector;
-use faint::core::rng::Rng;
+use faint::detect::mht::Geometry;
+use faint::detect::Detector;
+use faint::rng::Rng;
 use faint::host::reproduce::mht::{detectors, thresholds};
 use faint::host::simulate::mht::SeaClutter;
 use std::hint::black_box;

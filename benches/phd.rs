@@ -4,9 +4,9 @@
 //! Plus DBSCAN alone on the resampled particles of that frame.
 
 use criterion::{criterion_group, BatchSize, Criterion};
-use faint::core::detect::phd::{Dbscan, DbscanParams};
-use faint::core::detect::Detector;
-use faint::core::rng::Rng;
+use faint::detect::phd::{Dbscan, DbscanParams};
+use faint::detect::Detector;
+use faint::rng::Rng;
 use faint::host::instances::boxed;
 use faint::host::instances::phd::HostFilter;
 use faint::host::simulate::phd::{SixTargets, Variant};

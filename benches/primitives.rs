@@ -4,9 +4,9 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use faint::core::math::normalize_log_weights;
-use faint::core::particles::{resample, Scheme};
-use faint::core::rng::Rng;
+use faint::math::normalize_log_weights;
+use faint::particles::{resample, Scheme};
+use faint::rng::Rng;
 
 fn bench_resampling(c: &mut Criterion) {
     let mut g = c.benchmark_group("resample");

@@ -6,12 +6,12 @@
 
 use std::time::Instant;
 
-use faint::core::detect::cbmember::Likelihood;
-use faint::core::detect::Detector;
-use faint::core::model::range_doppler::{
+use faint::detect::cbmember::Likelihood;
+use faint::detect::Detector;
+use faint::model::range_doppler::{
     log_lr_blocked, log_lr_exact, peak_snr, BlockMap, Dequant, Kernel, PointModel,
 };
-use faint::core::rng::Rng;
+use faint::rng::Rng;
 use faint::host::instances::cbmember::HostFilter;
 use faint::host::simulate::cbmember::{MapSource, RotorUav};
 
@@ -93,7 +93,7 @@ fn main() {
             times[i] += t0.elapsed().as_secs_f64();
             let best = f.estimates().fold(
                 None,
-                |b: Option<faint::core::detect::cbmember::Estimate>, e| match b {
+                |b: Option<faint::detect::cbmember::Estimate>, e| match b {
                     Some(x) if x.existence >= e.existence => Some(x),
                     _ => Some(e),
                 },

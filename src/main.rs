@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
-use faint::core::detect::ScoreKind;
+use faint::detect::ScoreKind;
 use faint::host::detect;
 
 #[derive(Parser, Debug)]

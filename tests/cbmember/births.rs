@@ -1,10 +1,10 @@
 //! `faint detect`'s default CBMeMBer configuration finds a rotor UAV anywhere in the map
 //! (not only at the preset's birth point) and at another power scale.
 
-use faint::core::detect::cbmember::{CbmemberConfig, Likelihood};
-use faint::core::detect::Detector;
-use faint::core::model::range_doppler::PointModel;
-use faint::core::rng::Rng;
+use faint::detect::cbmember::{CbmemberConfig, Likelihood};
+use faint::detect::Detector;
+use faint::model::range_doppler::PointModel;
+use faint::rng::Rng;
 use faint::host::detect::{default_cbmember_file, normalise_frame, SpreadFrom};
 use faint::host::instances::cbmember::HostFilter;
 use faint::host::simulate::cbmember::{MapSource, RotorUav};
@@ -143,7 +143,7 @@ fn detections_do_not_depend_on_the_input_scale() {
 /// `birth.rho_db` is validated, and the file refuses an edited scale value.
 #[test]
 fn scale_settings_are_validated() {
-    use faint::core::detect::Validate;
+    use faint::detect::Validate;
     let f = default_cbmember_file(PointModel::Joint);
     let mut c = f.effective().unwrap();
     for bad in [

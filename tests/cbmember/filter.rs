@@ -4,14 +4,14 @@
 //! the complex / power / quantised map paths, and a statistical sanity check at fixed
 //! seeds.
 
-use faint::core::detect::cbmember::{CbmemberConfig, CbmemberTbd, Likelihood, DIM};
-use faint::core::detect::{run, Detector};
-use faint::core::model::range_doppler::{
+use faint::detect::cbmember::{CbmemberConfig, CbmemberTbd, Likelihood, DIM};
+use faint::detect::{run, Detector};
+use faint::model::range_doppler::{
     log_lr_blocked, log_lr_exact, point_velocities, quantise, simulate_complex, simulate_power,
     BlockMap, Dequant, Kernel, LitTarget, PointModel, RdGeometry, KAPPA, MAX_POINTS,
 };
-use faint::core::rng::Rng;
-use faint::core::{Complex32, Error};
+use faint::rng::Rng;
+use faint::{Complex32, Error};
 use faint::host::instances::cbmember::HostFilter;
 use faint::host::simulate::cbmember::{MapSource, RotorUav};
 use faint_golden::cbmember::GOLDEN_WINDOW;
@@ -146,7 +146,7 @@ fn small() -> CbmemberConfig {
     c.max_particles = 96;
     c.min_particles = 32;
     c.birth.particles = 48;
-    c.gain = faint::core::detect::cbmember::gain_for_snr(-8.0, 20_010.0, 1.0, c.noise_var);
+    c.gain = faint::detect::cbmember::gain_for_snr(-8.0, 20_010.0, 1.0, c.noise_var);
     c
 }
 
@@ -371,7 +371,7 @@ proptest! {
         cfg.max_particles = maxp;
         cfg.min_particles = minp.min(maxp);
         cfg.birth.particles = births;
-        cfg.gain = faint::core::detect::cbmember::gain_for_snr(snr, 20_010.0, 1.0, cfg.noise_var);
+        cfg.gain = faint::detect::cbmember::gain_for_snr(snr, 20_010.0, 1.0, cfg.noise_var);
         cfg.estimate_blades = blades;
         if doppler { cfg.model = PointModel::DopplerOnly; }
         if exact { cfg.likelihood = Likelihood::Exact; }

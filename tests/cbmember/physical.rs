@@ -1,10 +1,10 @@
 //! The default spread of `faint detect cbmember-doppler` on first-principles maps (the
 //! physics simulator: slow-time pulses, Hamming window, FFT; not the filter's model).
 
-use faint::core::detect::cbmember::{CbmemberConfig, Likelihood};
-use faint::core::detect::Detector;
-use faint::core::model::range_doppler::{PointModel, RdSpread};
-use faint::core::rng::Rng;
+use faint::detect::cbmember::{CbmemberConfig, Likelihood};
+use faint::detect::Detector;
+use faint::model::range_doppler::{PointModel, RdSpread};
+use faint::rng::Rng;
 use faint::host::detect::{default_cbmember_file, normalise_frame};
 use faint::host::instances::cbmember::HostFilter;
 use faint::host::physics::cubes::Axis;

@@ -2,13 +2,13 @@
 //! same predicted law as the exact proposal, so the existence recursion must agree in
 //! expectation; bad shares are typed errors; the output is finite and deterministic.
 
-use faint::core::detect::jott::JottTbd;
-use faint::core::detect::pf_lrt::PfLrt;
-use faint::core::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd};
-use faint::core::detect::Detector;
-use faint::core::model::doppler::DopplerReport;
-use faint::core::rng::Rng;
-use faint::core::{Complex32, Error};
+use faint::detect::jott::JottTbd;
+use faint::detect::pf_lrt::PfLrt;
+use faint::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd};
+use faint::detect::Detector;
+use faint::model::doppler::DopplerReport;
+use faint::rng::Rng;
+use faint::{Complex32, Error};
 use faint::host::reproduce::crpf::run_detector;
 use faint::host::simulate::crpf::{Noise, Othr, Run};
 

@@ -1,8 +1,8 @@
 //! Calibration: a threshold set on one batch of H0 runs gives, on an independent batch,
 //! a false-alarm rate compatible with the target Pfa = 0.05.
 
-use faint::core::detect::crpf::CrpfConfig;
-use faint::core::rng::derive_seed;
+use faint::detect::crpf::CrpfConfig;
+use faint::rng::derive_seed;
 use faint::host::montecarlo::set_quiet;
 use faint::host::reproduce::crpf::{batch, METHODS};
 use faint::host::simulate::crpf::{Noise, Othr};

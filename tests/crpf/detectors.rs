@@ -1,15 +1,15 @@
 //! Behaviour of CRPF-TBD and its comparators on the OTHR scenario at fixed seeds, and
 //! their handling of bad input.
 
-use faint::core::detect::crpf::{CrpfConfig, CrpfTbd, Weighting};
-use faint::core::detect::jott::JottTbd;
-use faint::core::detect::pf_lrt::PfLrt;
-use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint::core::detect::Detector;
-use faint::core::model::doppler::{estimate_noise_variance, DopplerReport};
-use faint::core::rng::Rng;
-use faint::core::statistic::zeta_k;
-use faint::core::{Complex32, Error};
+use faint::detect::crpf::{CrpfConfig, CrpfTbd, Weighting};
+use faint::detect::jott::JottTbd;
+use faint::detect::pf_lrt::PfLrt;
+use faint::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint::detect::Detector;
+use faint::model::doppler::{estimate_noise_variance, DopplerReport};
+use faint::rng::Rng;
+use faint::statistic::zeta_k;
+use faint::{Complex32, Error};
 use faint::host::reproduce::crpf::run_detector;
 use faint::host::simulate::crpf::{Noise, Othr, Run};
 

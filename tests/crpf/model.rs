@@ -1,8 +1,8 @@
 //! The tabulated observation model `h_k(x)` against the exact windowed DFT in `f64`.
 
-use faint::core::model::doppler::*;
-use faint::core::rng::Rng;
-use faint::core::Complex32;
+use faint::model::doppler::*;
+use faint::rng::Rng;
+use faint::Complex32;
 use faint::host::simulate::crpf::{window, windowed_dft};
 
 /// Exact `h_b = A sum_n w_n exp(j 2 pi fd n ts) exp(-j 2 pi b n / m)` over all bins, f64.
@@ -109,7 +109,7 @@ fn scenario_dft_agrees_with_model_on_noise_free_target() {
 
 #[test]
 fn bad_configs_and_frames_are_errors() {
-    use faint::core::Error;
+    use faint::Error;
     assert!(DopplerModel::new(4, 0.02, Window::Hamming).is_err());
     assert!(DopplerModel::new(MAX_BINS + 1, 0.02, Window::Hamming).is_err());
     assert!(DopplerModel::new(32, 0.0, Window::Hamming).is_err());

@@ -1,6 +1,6 @@
 //! The OTHR noise generators: complex Gaussian and complex generalized Gaussian (c = 0.1).
 
-use faint::core::rng::Rng;
+use faint::rng::Rng;
 use faint::host::simulate::crpf::*;
 
 #[test]

@@ -6,11 +6,11 @@
 //! 512-bin capacity, CRPF-TBD's 20 KB cache and 4 KB previous frame, the comparators'
 //! 8 KB whitener).
 
-use faint::core::detect::crpf::CrpfTbd;
-use faint::core::detect::jott::JottTbd;
-use faint::core::detect::pf_lrt::PfLrt;
-use faint::core::detect::pf_tbd::PfTbd;
-use faint::core::model::doppler::MAX_BINS;
+use faint::detect::crpf::CrpfTbd;
+use faint::detect::jott::JottTbd;
+use faint::detect::pf_lrt::PfLrt;
+use faint::detect::pf_tbd::PfTbd;
+use faint::model::doppler::MAX_BINS;
 use std::mem::size_of;
 
 fn check(name: &str, n: usize, size: usize, per: usize) {

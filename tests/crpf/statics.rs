@@ -2,14 +2,14 @@
 //! from `new_unconfigured()` on the heap (`faint_host::instances`; the firmware keeps
 //! the same value in `static` memory).
 
-use faint::core::detect::crpf::{CrpfConfig, CrpfTbd, Weighting};
-use faint::core::detect::jott::JottTbd;
-use faint::core::detect::pf_lrt::PfLrt;
-use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint::core::detect::Detector;
-use faint::core::model::doppler::{DopplerModel, DopplerReport, Window};
-use faint::core::rng::Rng;
-use faint::core::Complex32;
+use faint::detect::crpf::{CrpfConfig, CrpfTbd, Weighting};
+use faint::detect::jott::JottTbd;
+use faint::detect::pf_lrt::PfLrt;
+use faint::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint::detect::Detector;
+use faint::model::doppler::{DopplerModel, DopplerReport, Window};
+use faint::rng::Rng;
+use faint::Complex32;
 use faint::host::instances::unconfigured;
 
 const N: usize = 64;
@@ -96,14 +96,14 @@ fn reconfigure_reuses_the_table_only_for_the_same_frame_format() {
     let seed = 11;
     let cfg = CrpfConfig::othr();
     let hann = CrpfConfig {
-        model: faint::core::model::doppler::ModelConfig {
+        model: faint::model::doppler::ModelConfig {
             window: Window::Hann,
             ..cfg.model
         },
         ..cfg
     };
     let slower = CrpfConfig {
-        model: faint::core::model::doppler::ModelConfig {
+        model: faint::model::doppler::ModelConfig {
             ts: cfg.model.ts * 0.8,
             ..cfg.model
         },

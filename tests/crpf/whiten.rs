@@ -1,13 +1,13 @@
 //! Whitening by the window's bin covariance (`model::doppler::unwindow`) and the
 //! comparators' window-aware likelihood built on it.
 
-use faint::core::detect::jott::JottTbd;
-use faint::core::detect::pf_lrt::PfLrt;
-use faint::core::detect::pf_tbd::GaussConfig;
-use faint::core::detect::Detector;
-use faint::core::model::doppler::{unwindow, Likelihood, ModelConfig, Whitener, Window, MAX_BINS};
-use faint::core::rng::Rng;
-use faint::core::Complex32;
+use faint::detect::jott::JottTbd;
+use faint::detect::pf_lrt::PfLrt;
+use faint::detect::pf_tbd::GaussConfig;
+use faint::detect::Detector;
+use faint::model::doppler::{unwindow, Likelihood, ModelConfig, Whitener, Window, MAX_BINS};
+use faint::rng::Rng;
+use faint::Complex32;
 use faint::host::simulate::crpf::{window_of, windowed_dft, Noise, Othr};
 
 fn samples(rng: &mut Rng, m: usize) -> Vec<(f64, f64)> {
@@ -275,7 +275,7 @@ fn window_likelihood_in_the_step_equals_the_prepass() {
 /// in the CGG N = 1000 table).
 #[test]
 fn reproduction_window_likelihood_equals_the_prepass_under_cgg() {
-    use faint::core::detect::crpf::CrpfConfig;
+    use faint::detect::crpf::CrpfConfig;
     use faint::host::reproduce::crpf::{run_stats, ComparatorModel, Likelihood as Lik};
     let sc = Othr::default();
     let cfg = CrpfConfig::othr();

@@ -2,15 +2,15 @@
 //! (a regression test: CRPF-TBD once reported no detection because its last report was
 //! not kept).
 
-use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
-use faint::core::detect::jott::JottTbd;
-use faint::core::detect::mht::MhtConfig;
-use faint::core::detect::pf_lrt::PfLrt;
-use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint::core::detect::{run, Detector, ScoreKind};
-use faint::core::model::doppler::DopplerReport;
-use faint::core::rng::Rng;
-use faint::core::Complex32;
+use faint::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint::detect::jott::JottTbd;
+use faint::detect::mht::MhtConfig;
+use faint::detect::pf_lrt::PfLrt;
+use faint::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint::detect::{run, Detector, ScoreKind};
+use faint::model::doppler::DopplerReport;
+use faint::rng::Rng;
+use faint::Complex32;
 use faint::host::instances::mht::Mht;
 use faint::host::simulate::crpf::{Noise, Othr};
 use faint::host::simulate::mht::SeaClutter;

@@ -3,14 +3,14 @@
 
 use std::path::Path;
 
-use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
-use faint::core::detect::jott::JottTbd;
-use faint::core::detect::mht::MhtConfig;
-use faint::core::detect::pf_lrt::PfLrt;
-use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint::core::detect::{run, Detector};
-use faint::core::model::doppler::{estimate_noise_variance, DopplerReport, ModelConfig};
-use faint::core::rng::Rng;
+use faint::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint::detect::jott::JottTbd;
+use faint::detect::mht::MhtConfig;
+use faint::detect::pf_lrt::PfLrt;
+use faint::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint::detect::{run, Detector};
+use faint::model::doppler::{estimate_noise_variance, DopplerReport, ModelConfig};
+use faint::rng::Rng;
 use faint::host::detect::default_classic;
 use faint::host::instances::mht::{Classic, Mht};
 use faint::host::instances::phd::HostFilter;
@@ -226,7 +226,7 @@ fn doppler_detectors_are_scale_free() {
     assert_eq!(code, 0, "{err}");
     let f = read_complex_frames(&file).unwrap();
     let scaled = |k: f32, name: &str| {
-        let frames: Vec<Vec<faint::core::Complex32>> = (0..f.frames())
+        let frames: Vec<Vec<faint::Complex32>> = (0..f.frames())
             .map(|i| f.frame(i).iter().map(|z| z * k).collect())
             .collect();
         let p = dir.join(name);
@@ -524,8 +524,8 @@ fn truth_numbered_from_one() {
 
 #[test]
 fn cbmember_detectors_round_trip() {
-    use faint::core::detect::cbmember::CbmemberConfig;
-    use faint::core::model::range_doppler::PointModel;
+    use faint::detect::cbmember::CbmemberConfig;
+    use faint::model::range_doppler::PointModel;
     use faint::host::instances::cbmember::HostFilter as Cbm;
     use faint::host::simulate::cbmember::{MapSource, RotorUav};
     let dir = temp("rt-cbm");
@@ -579,7 +579,7 @@ fn cbmember_detectors_round_trip() {
 /// the zero phase it was run with, and so do the reproductions' presets.
 #[test]
 fn doppler_phase_defaults_and_files_without_the_key() {
-    use faint::core::model::doppler::Phase;
+    use faint::model::doppler::Phase;
     use faint::host::detect::{find, DopplerFile};
     assert_eq!(CrpfConfig::othr().model.phase, Phase::Zero);
     assert_eq!(GaussConfig::othr(1.0).model.phase, Phase::Zero);

@@ -3,16 +3,16 @@
 //! succeeds: `step` returns a typed error, `detections` is empty and `reset` keeps it
 //! unconfigured; after `configure` it runs exactly as `new` would have built it.
 
-use faint::core::detect::cbmember::CbmemberTbd;
-use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
-use faint::core::detect::jott::JottTbd;
-use faint::core::detect::mht::{ClassicHough, ClassicHoughConfig, MhtConfig, MhtTbd};
-use faint::core::detect::pf_lrt::PfLrt;
-use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint::core::detect::phd::SmcPhdTbd;
-use faint::core::detect::{Detector, Validate};
-use faint::core::model::plot::Plot;
-use faint::core::Complex32;
+use faint::detect::cbmember::CbmemberTbd;
+use faint::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint::detect::jott::JottTbd;
+use faint::detect::mht::{ClassicHough, ClassicHoughConfig, MhtConfig, MhtTbd};
+use faint::detect::pf_lrt::PfLrt;
+use faint::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint::detect::phd::SmcPhdTbd;
+use faint::detect::{Detector, Validate};
+use faint::model::plot::Plot;
+use faint::Complex32;
 use faint::host::instances::{boxed, unconfigured};
 
 /// `step` on frames of the configured detector's shape fails (`must_err`; the classic

@@ -3,14 +3,14 @@
 //! bad input, properties (monotone merits, recovered tracks inside the windows,
 //! determinism), zero-initialised statics.
 
-use faint::core::detect::dp::{
+use faint::detect::dp::{
     arnold_words, first_clamped, pulford_words, second_order_words, transition_table, ArnoldDp,
     DpConfig, DpReport, DpTrack, Method, PulfordDp, SecondOrderDp, Transition,
 };
-use faint::core::detect::{run, Detector};
-use faint::core::dp_tbd;
-use faint::core::rng::Rng;
-use faint::core::Error;
+use faint::detect::{run, Detector};
+use faint::dp_tbd;
+use faint::rng::Rng;
+use faint::Error;
 use proptest::prelude::*;
 
 const M: usize = 6;
@@ -611,7 +611,7 @@ proptest! {
 /// targets (the firmware prints the same sizes) and on this host.
 #[test]
 fn static_ram_equals_the_formulas() {
-    use faint::core::detect::dp::{arnold_bytes, pulford_bytes, second_order_bytes};
+    use faint::detect::dp::{arnold_bytes, pulford_bytes, second_order_bytes};
     use std::mem::size_of;
     macro_rules! check {
         ($t:ident, $words:ident, $bytes:ident, $m:literal, $qb:literal, $l:literal, $c:ty) => {

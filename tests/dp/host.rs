@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
-use faint::core::detect::dp::{DpConfig, Method};
-use faint::core::detect::{run, Detector};
-use faint::core::rng::Rng;
+use faint::detect::dp::{DpConfig, Method};
+use faint::detect::{run, Detector};
+use faint::rng::Rng;
 use faint::host::io::output::write_real_frames;
 use faint::host::reproduce::dp::{trace, Variant};
 use faint::host::simulate::dp::{

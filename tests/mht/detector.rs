@@ -1,13 +1,13 @@
 //! MHT-TBD core: censoring against a brute-force MSHT reference, detection of a clean
 //! target, the classic baseline, quantisers, and bad input.
 
-use faint::core::detect::mht::{
+use faint::detect::mht::{
     ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, NO_PLOT,
 };
-use faint::core::detect::Detector;
-use faint::core::model::plot::Plot;
-use faint::core::rng::Rng;
-use faint::core::Error;
+use faint::detect::Detector;
+use faint::model::plot::Plot;
+use faint::rng::Rng;
+use faint::Error;
 use proptest::prelude::*;
 
 type Small = MhtTbd<96, 12, 64, 45, 8>;

@@ -1,8 +1,8 @@
 //! MHT-TBD analytic model: exact run-value law vs brute force and simulation, hit
 //! probabilities, and the model threshold applied in simulation.
 
-use faint::core::detect::Detector;
-use faint::core::rng::Rng;
+use faint::detect::Detector;
+use faint::rng::Rng;
 use faint::host::analysis::mht::{
     self as model, coverage_pmf, lattice_measure, run_value, run_value_pmf, run_value_pmf_brute,
     CellModel, ChainSource, CompoundModel, ModelParams,

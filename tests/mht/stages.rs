@@ -1,8 +1,8 @@
 //! Stage attribution of MHT-TBD (`reproduce::mht::stages`): its re-run of stage 3 gives
 //! the detector's confirmed tracks, and every target is attributed to exactly one stage.
 
-use faint::core::detect::Detector;
-use faint::core::rng::Rng;
+use faint::detect::Detector;
+use faint::rng::Rng;
 use faint::host::reproduce::mht::{attribute, detectors, stage3_fates, Fate};
 use faint::host::simulate::mht::SeaClutter;
 

@@ -4,10 +4,10 @@
 //! at lambda 0 one clean target was found 1 time in 50, and the classic Hough reported
 //! 52-64 lines in every clutter-only period at lambda >= 200 without a warning.
 
-use faint::core::detect::mht::MhtConfig;
-use faint::core::detect::Detector;
-use faint::core::model::plot::Plot;
-use faint::core::rng::Rng;
+use faint::detect::mht::MhtConfig;
+use faint::detect::Detector;
+use faint::model::plot::Plot;
+use faint::rng::Rng;
 use faint::host::detect::{clutter_density, mht_gamma};
 use faint::host::instances::mht::Mht;
 use faint::host::simulate::mht::SeaClutter;

@@ -2,10 +2,10 @@
 //! O(N^2) textbook DBSCAN, ENS-BS and divide-and-conquer non-dominated sorting versus
 //! O(N^2) peeling; swarm invariants (proptest).
 
-use faint::core::detect::phd::dbscan::{Dbscan, DbscanParams, NOISE};
-use faint::core::detect::phd::ndsort::{dominates, non_dominated_sort};
-use faint::core::detect::phd::pso::crowding_distance;
-use faint::core::rng::Rng;
+use faint::detect::phd::dbscan::{Dbscan, DbscanParams, NOISE};
+use faint::detect::phd::ndsort::{dominates, non_dominated_sort};
+use faint::detect::phd::pso::crowding_distance;
+use faint::rng::Rng;
 
 /// Textbook DBSCAN: neighbour lists by all-pairs scan.
 fn brute_dbscan(p: &[[f32; 2]], eps: f32, min_pts: usize) -> (Vec<bool>, Vec<i32>) {
@@ -217,7 +217,7 @@ fn crowding_gives_boundaries_the_maximum_and_inner_points_the_weighted_gap() {
 fn divide_and_conquer_ranks_match_brute_force_with_ties_and_many_objectives() {
     // Random sets with few levels (many ties and duplicates) and with many levels, up to
     // 8 objectives, sizes around the small-case cut-offs and well above them.
-    use faint::core::detect::phd::ndsort::{rank_sorted, Workspace};
+    use faint::detect::phd::ndsort::{rank_sorted, Workspace};
     let mut rng = Rng::seed_from_u64(78);
     for case in 0..300 {
         let n = 1 + rng.below(if case % 3 == 0 { 600 } else { 120 }) as usize;
@@ -260,8 +260,8 @@ fn divide_and_conquer_ranks_match_brute_force_with_ties_and_many_objectives() {
 }
 
 mod swarm_props {
-    use faint::core::detect::phd::pso::{PsoConfig, Swarm};
-    use faint::core::rng::Rng;
+    use faint::detect::phd::pso::{PsoConfig, Swarm};
+    use faint::rng::Rng;
     use proptest::prelude::*;
 
     type Sw = Swarm<1024, 8>;

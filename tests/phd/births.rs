@@ -2,9 +2,9 @@
 //! at the six-targets preset's birth points) and gives the same detections whatever the
 //! input's power scale.
 
-use faint::core::detect::phd::PhdConfig;
-use faint::core::detect::Detector;
-use faint::core::rng::Rng;
+use faint::detect::phd::PhdConfig;
+use faint::detect::Detector;
+use faint::rng::Rng;
 use faint::host::detect::{default_phd_file, normalise_frame};
 use faint::host::instances::phd::HostFilter;
 use faint::host::simulate::phd::{SixTargets, TargetSpec, TruthTarget, Variant};
@@ -213,8 +213,8 @@ fn scale_settings_refuse_contradictions() {
 /// spread; it needs no birth component.
 #[test]
 fn region_birth_mode_is_validated() {
-    use faint::core::detect::phd::{BirthMode, MAX_REGION_CELLS};
-    use faint::core::detect::Validate;
+    use faint::detect::phd::{BirthMode, MAX_REGION_CELLS};
+    use faint::detect::Validate;
     let mut c = default_phd_file(Variant::PhdTbd).effective().unwrap();
     assert_eq!(c.birth.n_components, 0);
     assert!(c.validate().is_ok());

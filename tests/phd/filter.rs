@@ -1,10 +1,10 @@
 //! SMC-PHD TBD / PSO-PHD-TBD filter behaviour on the `six-targets` preset: bad input,
 //! capacities, no-target behaviour, determinism.
 
-use faint::core::detect::phd::{PsoConfig, SmcPhdTbd};
-use faint::core::detect::Detector;
-use faint::core::rng::Rng;
-use faint::core::Error;
+use faint::detect::phd::{PsoConfig, SmcPhdTbd};
+use faint::detect::Detector;
+use faint::rng::Rng;
+use faint::Error;
 use faint::host::instances::phd::HostFilter;
 use faint::host::simulate::phd::{SixTargets, Variant};
 use faint::host::stats::ospa::ospa;
@@ -83,11 +83,11 @@ fn invalid_configurations_are_typed_errors() {
             Error::InvalidConfig("pso")
         );
         for bad in [
-            |c: &mut faint::core::detect::phd::PhdConfig| c.noise_var = 0.0,
-            |c: &mut faint::core::detect::phd::PhdConfig| c.p_survival = 1.5,
-            |c: &mut faint::core::detect::phd::PhdConfig| c.clutter_lambda = f32::NAN,
-            |c: &mut faint::core::detect::phd::PhdConfig| c.geometry.n_doppler = 0,
-            |c: &mut faint::core::detect::phd::PhdConfig| c.birth.n_components = 0,
+            |c: &mut faint::detect::phd::PhdConfig| c.noise_var = 0.0,
+            |c: &mut faint::detect::phd::PhdConfig| c.p_survival = 1.5,
+            |c: &mut faint::detect::phd::PhdConfig| c.clutter_lambda = f32::NAN,
+            |c: &mut faint::detect::phd::PhdConfig| c.geometry.n_doppler = 0,
+            |c: &mut faint::detect::phd::PhdConfig| c.birth.n_components = 0,
         ] {
             let mut c = sc.config(Variant::PhdTbd);
             bad(&mut c);

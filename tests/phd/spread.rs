@@ -4,7 +4,7 @@
 //! phase per frame) through `faint detect`'s machinery, with the one-cell response of the
 //! presets and with the response matched to the data.
 
-use faint::core::rng::{derive_seed, Rng};
+use faint::rng::{derive_seed, Rng};
 use faint::host::detect::{self, Request};
 use faint::host::physics::cubes::Response;
 use faint::host::physics::{Physics, SimRun};
@@ -142,7 +142,7 @@ fn a_matched_spread_tracks_where_the_one_cell_response_does_not() {
 /// axes were separate, one number for all three; other lengths are refused.
 #[test]
 fn half_width_reads_one_number_or_three() {
-    use faint::core::model::power_cube::PointSpread;
+    use faint::model::power_cube::PointSpread;
     let read = |w: &str| {
         serde_json::from_str::<PointSpread>(&format!(
             r#"{{"loss_range": 1.0, "loss_doppler": 1.0, "loss_azimuth": 1.0, "half_width": {w}}}"#

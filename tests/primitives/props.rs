@@ -1,9 +1,9 @@
 //! Property tests of the core primitives: resampling invariants and unbiasedness,
 //! log-weight normalisation, determinism.
 
-use faint::core::math;
-use faint::core::particles::{gather_in_place, resample, Scheme};
-use faint::core::rng::Rng;
+use faint::math;
+use faint::particles::{gather_in_place, resample, Scheme};
+use faint::rng::Rng;
 use proptest::prelude::*;
 
 const SCHEMES: [Scheme; 4] = [

@@ -8,7 +8,7 @@
 //! Moment tolerances are 5 standard errors of the sample moment, computed from the
 //! exact higher moments of the target distribution.
 
-use faint::core::rng::Rng;
+use faint::rng::Rng;
 use statrs::distribution::{ContinuousCDF, Exp, Normal};
 
 const N: usize = 200_000;

@@ -4,18 +4,18 @@
 //! holds (the test checks the typed error) or a documented recovery (the test runs the
 //! detector and checks its outputs are finite).
 
-use faint::core::detect::crpf::{CrpfConfig, CrpfTbd};
-use faint::core::detect::jott::JottTbd;
-use faint::core::detect::mht::censoring::Censor;
-use faint::core::detect::mht::{ClassicHoughConfig, Geometry, MhtConfig, MAX_DRHO_MIN};
-use faint::core::detect::pf_lrt::PfLrt;
-use faint::core::detect::pf_tbd::{GaussConfig, PfTbd};
-use faint::core::detect::phd::{Dbscan, DbscanParams, Extractor, MAX_GENERATIONS, MAX_INTENSITY};
-use faint::core::detect::{Detector, Validate};
-use faint::core::model::doppler::{check_frame, estimate_noise_variance};
-use faint::core::model::plot::Plot;
-use faint::core::rng::Rng;
-use faint::core::{Complex32, Error};
+use faint::detect::crpf::{CrpfConfig, CrpfTbd};
+use faint::detect::jott::JottTbd;
+use faint::detect::mht::censoring::Censor;
+use faint::detect::mht::{ClassicHoughConfig, Geometry, MhtConfig, MAX_DRHO_MIN};
+use faint::detect::pf_lrt::PfLrt;
+use faint::detect::pf_tbd::{GaussConfig, PfTbd};
+use faint::detect::phd::{Dbscan, DbscanParams, Extractor, MAX_GENERATIONS, MAX_INTENSITY};
+use faint::detect::{Detector, Validate};
+use faint::model::doppler::{check_frame, estimate_noise_variance};
+use faint::model::plot::Plot;
+use faint::rng::Rng;
+use faint::{Complex32, Error};
 use faint::host::instances::mht::Mht;
 use faint::host::instances::phd::HostFilter;
 use faint::host::reliability::check_outputs;
@@ -57,10 +57,10 @@ fn doppler_sample_interval_and_jitter_near_f32_max_are_rejected() {
     c.jitter_std = [1e30; 3];
     assert!(matches!(c.validate(), Err(Error::InvalidConfig(f)) if f.contains("jitter")));
     // The far-out Doppler path itself no longer overflows: a Doppler of 3e38 Hz.
-    let m = faint::core::model::doppler::DopplerModel::new(
+    let m = faint::model::doppler::DopplerModel::new(
         32,
         0.02,
-        faint::core::model::doppler::Window::Hamming,
+        faint::model::doppler::Window::Hamming,
     )
     .unwrap();
     let z = vec![Complex32::new(1.0, 0.0); 32];
@@ -334,8 +334,8 @@ fn track_recovery_with_fewer_flag_rows_than_scans_is_total() {
     // `dmht::recover` indexed `flags[s]` for every scan: fewer flag rows than scans
     // panicked (found by the `panic-never-mht` link check). The scans without a flag row
     // are now not associated.
-    use faint::core::detect::mht::dmht::{recover, Assoc};
-    use faint::core::detect::mht::{Peak, Track, NO_PLOT};
+    use faint::detect::mht::dmht::{recover, Assoc};
+    use faint::detect::mht::{Peak, Track, NO_PLOT};
     let g = Geometry::<64, 16>::for_area([0.0, 100.0, 0.0, 100.0]);
     let a = [Plot::new(1.0, 50.0, 50.0); 4];
     let scans: [&[Plot]; 3] = [&a, &a, &a];
@@ -356,7 +356,7 @@ fn swarm_run_with_len_past_its_capacity_is_total() {
     // `Swarm::len` is public: set past the parent capacity `S / 2`, `run` wrote children
     // past `S` (index out of bounds; found by the `panic-never-phd` link check). It now
     // runs on the first `S / 2` parents; `best_objective` past `S` is objective 0.
-    use faint::core::detect::phd::pso::{PsoConfig, Swarm};
+    use faint::detect::phd::pso::{PsoConfig, Swarm};
     let mut sw = Swarm::<8, 2>::new();
     for i in 0..4u32 {
         assert!(sw.push([i as f32, 0.0], 0.25, i, 0));
@@ -376,7 +376,7 @@ fn censoring_with_a_gate_wider_than_the_area_is_bounded() {
     // search visit up to P^5 partial chains (2.9 s for one scan; fuzz corpus
     // `mht-slow-935-0.json`); the budget of completed chains did not bound the partial
     // ones. The search now stops after NODE_BUDGET_PER_PLOT * P partial chains.
-    use faint::core::detect::mht::censoring::NODE_BUDGET_PER_PLOT;
+    use faint::detect::mht::censoring::NODE_BUDGET_PER_PLOT;
     let g = Geometry::<256, 180>::for_area([0.0, 6000.0, 0.0, 6000.0]);
     let mut rng = Rng::seed_from_u64(8);
     // 64 plots per scan in a capacity of 256: 256 gated pairs per scan, about four
@@ -468,7 +468,7 @@ fn non_dominated_sort_with_nan_values_terminates() {
     // libFuzzer report): a swarm position that overflowed gave a NaN fitness, the pivot of
     // the divide-and-conquer sort then separated nothing, and `helper_a` recursed on the
     // same list until the stack overflowed. Any value now gives ranks.
-    use faint::core::detect::phd::ndsort::{rank_sorted, Workspace};
+    use faint::detect::phd::ndsort::{rank_sorted, Workspace};
     big_stack(|| {
         let mut rng = Rng::seed_from_u64(79);
         for case in 0..200 {

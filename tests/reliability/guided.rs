@@ -2,10 +2,10 @@
 //! `fuzz/` targets) on the stable toolchain: every detector's fuzz shape accepts its
 //! preset, random inputs find nothing, and the checks catch what they are meant to catch.
 
-use faint::core::detect::dp::{DpConfig, Method};
-use faint::core::detect::{Detection, Detector, ScoreKind};
-use faint::core::rng::Rng;
-use faint::core::{Error, Result};
+use faint::detect::dp::{DpConfig, Method};
+use faint::detect::{Detection, Detector, ScoreKind};
+use faint::rng::Rng;
+use faint::{Error, Result};
 use faint::host::reliability::frames::reals;
 use faint::host::reliability::guided::{self, by_name, run, Spec};
 use faint::host::reliability::Kind;
