@@ -215,7 +215,7 @@ fn fixed_share_h0_existence_stays_low_and_bad_frames_are_handled() {
     // fixed share is no higher than the exact proposal's on the same runs plus 0.05, and
     // below 0.5 (a target at 15 dB gives 0.9+). The exact proposal's own level is
     // 0.28 (PF-TBD) and 0.40 (JOTT) under Gaussian noise: the independent-bin likelihood
-    // is overconfident on the windowed bins (docs/crpf.md, Fidelity).
+    // is overconfident on the windowed bins (docs/measurements/crpf.md, Fidelity).
     let sc = Othr::default();
     for noise in [Noise::Gaussian, Noise::Cgg] {
         let mut m = [[0.0f32; 2]; 2];
