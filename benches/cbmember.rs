@@ -10,11 +10,11 @@
 use criterion::{criterion_group, BatchSize, Criterion};
 use faint::detect::cbmember::Likelihood;
 use faint::detect::Detector;
-use faint::model::range_doppler::{quantise, Dequant, PointModel};
-use faint::rng::Rng;
 use faint::host::instances::boxed;
 use faint::host::instances::cbmember::{HostFilter, HostFilterU8};
 use faint::host::simulate::cbmember::{MapSource, RotorUav};
+use faint::model::range_doppler::{quantise, Dequant, PointModel};
+use faint::rng::Rng;
 
 const ROWS: [(&str, PointModel, usize); 4] = [
     ("doppler_only_1500", PointModel::DopplerOnly, 1500),

@@ -10,11 +10,11 @@ use faint::detect::jott::JottTbd;
 use faint::detect::pf_lrt::PfLrt;
 use faint::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint::detect::{run, Detector};
+use faint::host::instances::boxed;
+use faint::host::simulate::crpf::{Noise, Othr};
 use faint::model::doppler::{estimate_noise_variance, DopplerReport};
 use faint::rng::Rng;
 use faint::Complex32;
-use faint::host::instances::boxed;
-use faint::host::simulate::crpf::{Noise, Othr};
 use std::hint::black_box;
 
 fn run_all<D: Detector<Frame = [Complex32], Report = DopplerReport>>(

@@ -4,9 +4,9 @@
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use faint::detect::mht::Geometry;
 use faint::detect::Detector;
-use faint::rng::Rng;
 use faint::host::reproduce::mht::{detectors, thresholds};
 use faint::host::simulate::mht::SeaClutter;
+use faint::rng::Rng;
 use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {

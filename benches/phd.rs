@@ -6,10 +6,10 @@
 use criterion::{criterion_group, BatchSize, Criterion};
 use faint::detect::phd::{Dbscan, DbscanParams};
 use faint::detect::Detector;
-use faint::rng::Rng;
 use faint::host::instances::boxed;
 use faint::host::instances::phd::HostFilter;
 use faint::host::simulate::phd::{SixTargets, Variant};
+use faint::rng::Rng;
 
 fn bench_phd(c: &mut Criterion) {
     let sc = SixTargets::new(9.0);

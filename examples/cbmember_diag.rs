@@ -8,12 +8,12 @@ use std::time::Instant;
 
 use faint::detect::cbmember::Likelihood;
 use faint::detect::Detector;
+use faint::host::instances::cbmember::HostFilter;
+use faint::host::simulate::cbmember::{MapSource, RotorUav};
 use faint::model::range_doppler::{
     log_lr_blocked, log_lr_exact, peak_snr, BlockMap, Dequant, Kernel, PointModel,
 };
 use faint::rng::Rng;
-use faint::host::instances::cbmember::HostFilter;
-use faint::host::simulate::cbmember::{MapSource, RotorUav};
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();

@@ -3,11 +3,11 @@
 
 use faint::detect::cbmember::{CbmemberConfig, Likelihood};
 use faint::detect::Detector;
-use faint::model::range_doppler::PointModel;
-use faint::rng::Rng;
 use faint::host::detect::{default_cbmember_file, normalise_frame, SpreadFrom};
 use faint::host::instances::cbmember::HostFilter;
 use faint::host::simulate::cbmember::{MapSource, RotorUav};
+use faint::model::range_doppler::PointModel;
+use faint::rng::Rng;
 
 /// The default file with the model maps' own spread (the preset's `zeta_r = 3` m,
 /// `zeta_v = 5` m/s, with its 16-bin blocked likelihood): these tests run on maps drawn

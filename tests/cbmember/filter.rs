@@ -6,14 +6,14 @@
 
 use faint::detect::cbmember::{CbmemberConfig, CbmemberTbd, Likelihood, DIM};
 use faint::detect::{run, Detector};
+use faint::host::instances::cbmember::HostFilter;
+use faint::host::simulate::cbmember::{MapSource, RotorUav};
 use faint::model::range_doppler::{
     log_lr_blocked, log_lr_exact, point_velocities, quantise, simulate_complex, simulate_power,
     BlockMap, Dequant, Kernel, LitTarget, PointModel, RdGeometry, KAPPA, MAX_POINTS,
 };
 use faint::rng::Rng;
 use faint::{Complex32, Error};
-use faint::host::instances::cbmember::HostFilter;
-use faint::host::simulate::cbmember::{MapSource, RotorUav};
 use faint_golden::cbmember::GOLDEN_WINDOW;
 use proptest::prelude::*;
 

@@ -3,12 +3,12 @@
 
 use faint::detect::cbmember::{CbmemberConfig, Likelihood};
 use faint::detect::Detector;
-use faint::model::range_doppler::{PointModel, RdSpread};
-use faint::rng::Rng;
 use faint::host::detect::{default_cbmember_file, normalise_frame};
 use faint::host::instances::cbmember::HostFilter;
 use faint::host::physics::cubes::Axis;
 use faint::host::physics::maps::{MapPhysics, Rotor};
+use faint::model::range_doppler::{PointModel, RdSpread};
+use faint::rng::Rng;
 
 /// Runs of 10 frames (a target at 20 dB peak-pixel SNR, random start and velocity over
 /// the map, with `blades` rotor blades of eq. 11 or none): how many runs' last frame

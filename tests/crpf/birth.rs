@@ -6,11 +6,11 @@ use faint::detect::jott::JottTbd;
 use faint::detect::pf_lrt::PfLrt;
 use faint::detect::pf_tbd::{BirthProposal, GaussConfig, PfTbd};
 use faint::detect::Detector;
+use faint::host::reproduce::crpf::run_detector;
+use faint::host::simulate::crpf::{Noise, Othr, Run};
 use faint::model::doppler::DopplerReport;
 use faint::rng::Rng;
 use faint::{Complex32, Error};
-use faint::host::reproduce::crpf::run_detector;
-use faint::host::simulate::crpf::{Noise, Othr, Run};
 
 use super::detectors::var_of;
 

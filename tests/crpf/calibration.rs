@@ -2,11 +2,11 @@
 //! a false-alarm rate compatible with the target Pfa = 0.05.
 
 use faint::detect::crpf::CrpfConfig;
-use faint::rng::derive_seed;
 use faint::host::montecarlo::set_quiet;
 use faint::host::reproduce::crpf::{batch, METHODS};
 use faint::host::simulate::crpf::{Noise, Othr};
 use faint::host::stats::detection::{detection_rate, threshold_at_pfa};
+use faint::rng::derive_seed;
 
 #[test]
 fn threshold_from_batch_a_holds_on_batch_b() {

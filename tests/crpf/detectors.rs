@@ -6,12 +6,12 @@ use faint::detect::jott::JottTbd;
 use faint::detect::pf_lrt::PfLrt;
 use faint::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint::detect::Detector;
+use faint::host::reproduce::crpf::run_detector;
+use faint::host::simulate::crpf::{Noise, Othr, Run};
 use faint::model::doppler::{estimate_noise_variance, DopplerReport};
 use faint::rng::Rng;
 use faint::statistic::zeta_k;
 use faint::{Complex32, Error};
-use faint::host::reproduce::crpf::run_detector;
-use faint::host::simulate::crpf::{Noise, Othr, Run};
 
 const N: usize = 1000;
 

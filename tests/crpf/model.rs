@@ -1,9 +1,9 @@
 //! The tabulated observation model `h_k(x)` against the exact windowed DFT in `f64`.
 
+use faint::host::simulate::crpf::{window, windowed_dft};
 use faint::model::doppler::*;
 use faint::rng::Rng;
 use faint::Complex32;
-use faint::host::simulate::crpf::{window, windowed_dft};
 
 /// Exact `h_b = A sum_n w_n exp(j 2 pi fd n ts) exp(-j 2 pi b n / m)` over all bins, f64.
 fn exact(fd: f64, amp: f64, m: usize, ts: f64) -> Vec<(f64, f64)> {

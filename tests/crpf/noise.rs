@@ -1,7 +1,7 @@
 //! The OTHR noise generators: complex Gaussian and complex generalized Gaussian (c = 0.1).
 
-use faint::rng::Rng;
 use faint::host::simulate::crpf::*;
+use faint::rng::Rng;
 
 #[test]
 fn complex_gaussian_variance_and_kurtosis() {

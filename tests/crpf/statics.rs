@@ -7,10 +7,10 @@ use faint::detect::jott::JottTbd;
 use faint::detect::pf_lrt::PfLrt;
 use faint::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint::detect::Detector;
+use faint::host::instances::unconfigured;
 use faint::model::doppler::{DopplerModel, DopplerReport, Window};
 use faint::rng::Rng;
 use faint::Complex32;
-use faint::host::instances::unconfigured;
 
 const N: usize = 64;
 

@@ -5,10 +5,10 @@ use faint::detect::jott::JottTbd;
 use faint::detect::pf_lrt::PfLrt;
 use faint::detect::pf_tbd::GaussConfig;
 use faint::detect::Detector;
+use faint::host::simulate::crpf::{window_of, windowed_dft, Noise, Othr};
 use faint::model::doppler::{unwindow, Likelihood, ModelConfig, Whitener, Window, MAX_BINS};
 use faint::rng::Rng;
 use faint::Complex32;
-use faint::host::simulate::crpf::{window_of, windowed_dft, Noise, Othr};
 
 fn samples(rng: &mut Rng, m: usize) -> Vec<(f64, f64)> {
     (0..m)

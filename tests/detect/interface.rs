@@ -8,12 +8,12 @@ use faint::detect::mht::MhtConfig;
 use faint::detect::pf_lrt::PfLrt;
 use faint::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint::detect::{run, Detector, ScoreKind};
-use faint::model::doppler::DopplerReport;
-use faint::rng::Rng;
-use faint::Complex32;
 use faint::host::instances::mht::Mht;
 use faint::host::simulate::crpf::{Noise, Othr};
 use faint::host::simulate::mht::SeaClutter;
+use faint::model::doppler::DopplerReport;
+use faint::rng::Rng;
+use faint::Complex32;
 
 fn check_doppler<D: Detector<Frame = [Complex32], Report = DopplerReport>>(
     det: &mut D,

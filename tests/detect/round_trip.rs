@@ -9,8 +9,6 @@ use faint::detect::mht::MhtConfig;
 use faint::detect::pf_lrt::PfLrt;
 use faint::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint::detect::{run, Detector};
-use faint::model::doppler::{estimate_noise_variance, DopplerReport, ModelConfig};
-use faint::rng::Rng;
 use faint::host::detect::default_classic;
 use faint::host::instances::mht::{Classic, Mht};
 use faint::host::instances::phd::HostFilter;
@@ -19,6 +17,8 @@ use faint::host::simulate::crpf::{Noise, Othr};
 use faint::host::simulate::mht::SeaClutter;
 use faint::host::simulate::phd::SixTargets;
 use faint::host::simulate::phd::Variant;
+use faint::model::doppler::{estimate_noise_variance, DopplerReport, ModelConfig};
+use faint::rng::Rng;
 
 use super::{faint, s, temp};
 
@@ -525,9 +525,9 @@ fn truth_numbered_from_one() {
 #[test]
 fn cbmember_detectors_round_trip() {
     use faint::detect::cbmember::CbmemberConfig;
-    use faint::model::range_doppler::PointModel;
     use faint::host::instances::cbmember::HostFilter as Cbm;
     use faint::host::simulate::cbmember::{MapSource, RotorUav};
+    use faint::model::range_doppler::PointModel;
     let dir = temp("rt-cbm");
     let file = dir.join("maps.npy");
     let (code, _, err) = faint(&[
@@ -579,8 +579,8 @@ fn cbmember_detectors_round_trip() {
 /// the zero phase it was run with, and so do the reproductions' presets.
 #[test]
 fn doppler_phase_defaults_and_files_without_the_key() {
-    use faint::model::doppler::Phase;
     use faint::host::detect::{find, DopplerFile};
+    use faint::model::doppler::Phase;
     assert_eq!(CrpfConfig::othr().model.phase, Phase::Zero);
     assert_eq!(GaussConfig::othr(1.0).model.phase, Phase::Zero);
     assert_eq!(Othr::default().model().phase, Phase::Zero);

@@ -11,9 +11,9 @@ use faint::detect::pf_lrt::PfLrt;
 use faint::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint::detect::phd::SmcPhdTbd;
 use faint::detect::{Detector, Validate};
+use faint::host::instances::{boxed, unconfigured};
 use faint::model::plot::Plot;
 use faint::Complex32;
-use faint::host::instances::{boxed, unconfigured};
 
 /// `step` on frames of the configured detector's shape fails (`must_err`; the classic
 /// Hough transform has no unconfigured check), and any step leaves no detection; so

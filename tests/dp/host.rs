@@ -6,13 +6,13 @@ use std::path::Path;
 
 use faint::detect::dp::{DpConfig, Method};
 use faint::detect::{run, Detector};
-use faint::rng::Rng;
 use faint::host::io::output::write_real_frames;
 use faint::host::reproduce::dp::{trace, Variant};
 use faint::host::simulate::dp::{
     boxed, pad_image, Arnold25, Arnold25At256, Arnold9, Arnold9At256, DimPoint, Pulford9,
     Pulford9At256, Second25, Second25At512, Second9, Second9At256,
 };
+use faint::rng::Rng;
 
 use super::{faint, s, temp};
 

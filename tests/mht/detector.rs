@@ -1,9 +1,7 @@
 //! MHT-TBD core: censoring against a brute-force MSHT reference, detection of a clean
 //! target, the classic baseline, quantisers, and bad input.
 
-use faint::detect::mht::{
-    ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, NO_PLOT,
-};
+use faint::detect::mht::{ClassicHough, ClassicHoughConfig, Geometry, MhtConfig, MhtTbd, NO_PLOT};
 use faint::detect::Detector;
 use faint::model::plot::Plot;
 use faint::rng::Rng;

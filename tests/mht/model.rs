@@ -2,13 +2,13 @@
 //! probabilities, and the model threshold applied in simulation.
 
 use faint::detect::Detector;
-use faint::rng::Rng;
 use faint::host::analysis::mht::{
     self as model, coverage_pmf, lattice_measure, run_value, run_value_pmf, run_value_pmf_brute,
     CellModel, ChainSource, CompoundModel, ModelParams,
 };
 use faint::host::reproduce::mht::{detectors, evaluate_trial, model_params};
 use faint::host::simulate::mht::SeaClutter;
+use faint::rng::Rng;
 
 #[test]
 fn run_value_examples() {

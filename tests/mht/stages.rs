@@ -2,9 +2,9 @@
 //! the detector's confirmed tracks, and every target is attributed to exactly one stage.
 
 use faint::detect::Detector;
-use faint::rng::Rng;
 use faint::host::reproduce::mht::{attribute, detectors, stage3_fates, Fate};
 use faint::host::simulate::mht::SeaClutter;
+use faint::rng::Rng;
 
 /// The instrumented stage 3 confirms exactly the detector's tracks (peak, line, plots),
 /// at two densities and thresholds where peaks are short, merged and residual-rejected.

@@ -6,11 +6,11 @@
 
 use faint::detect::mht::MhtConfig;
 use faint::detect::Detector;
-use faint::model::plot::Plot;
-use faint::rng::Rng;
 use faint::host::detect::{clutter_density, mht_gamma};
 use faint::host::instances::mht::Mht;
 use faint::host::simulate::mht::SeaClutter;
+use faint::model::plot::Plot;
+use faint::rng::Rng;
 
 use crate::common::{faint_quiet, temp};
 

@@ -4,10 +4,10 @@
 
 use faint::detect::phd::PhdConfig;
 use faint::detect::Detector;
-use faint::rng::Rng;
 use faint::host::detect::{default_phd_file, normalise_frame};
 use faint::host::instances::phd::HostFilter;
 use faint::host::simulate::phd::{SixTargets, TargetSpec, TruthTarget, Variant};
+use faint::rng::Rng;
 
 /// The preset's three birth means (x, y) in m.
 const PRESET_BIRTHS: [[f64; 2]; 3] = [[250.0, 1500.0], [1000.0, 1000.0], [1750.0, 500.0]];

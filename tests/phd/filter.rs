@@ -3,11 +3,11 @@
 
 use faint::detect::phd::{PsoConfig, SmcPhdTbd};
 use faint::detect::Detector;
-use faint::rng::Rng;
-use faint::Error;
 use faint::host::instances::phd::HostFilter;
 use faint::host::simulate::phd::{SixTargets, Variant};
 use faint::host::stats::ospa::ospa;
+use faint::rng::Rng;
+use faint::Error;
 
 /// The host filter is ~5 MB of fixed arrays: run on a thread with a big stack.
 fn big_stack(f: impl FnOnce() + Send + 'static) {

@@ -4,10 +4,10 @@
 //! phase per frame) through `faint detect`'s machinery, with the one-cell response of the
 //! presets and with the response matched to the data.
 
-use faint::rng::{derive_seed, Rng};
 use faint::host::detect::{self, Request};
 use faint::host::physics::cubes::Response;
 use faint::host::physics::{Physics, SimRun};
+use faint::rng::{derive_seed, Rng};
 use serde_json::Value;
 
 use crate::common::temp;

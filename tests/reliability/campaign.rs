@@ -1,10 +1,10 @@
 //! The fuzz corpus replayed, and a short campaign over every detector (the CI smoke run;
 //! the full campaigns are `faint fuzz`, see docs/reliability.md).
 
-use faint::rng::Rng;
 use faint::host::reliability::cli::{fuzz_all, FuzzArgs};
 use faint::host::reliability::frames::{complex, plots, reals, Mode};
 use faint::host::reliability::{mutate, replay, Finding};
+use faint::rng::Rng;
 
 #[test]
 fn corpus_replays_clean() {

@@ -12,15 +12,15 @@ use faint::detect::pf_lrt::PfLrt;
 use faint::detect::pf_tbd::{GaussConfig, PfTbd};
 use faint::detect::phd::{Dbscan, DbscanParams, Extractor, MAX_GENERATIONS, MAX_INTENSITY};
 use faint::detect::{Detector, Validate};
-use faint::model::doppler::{check_frame, estimate_noise_variance};
-use faint::model::plot::Plot;
-use faint::rng::Rng;
-use faint::{Complex32, Error};
 use faint::host::instances::mht::Mht;
 use faint::host::instances::phd::HostFilter;
 use faint::host::reliability::check_outputs;
 use faint::host::reliability::targets::small_phd;
 use faint::host::simulate::phd::Variant;
+use faint::model::doppler::{check_frame, estimate_noise_variance};
+use faint::model::plot::Plot;
+use faint::rng::Rng;
+use faint::{Complex32, Error};
 
 /// Runs `f` on a thread with a 256 MB stack (the host filters are large values).
 fn big_stack<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
@@ -57,12 +57,9 @@ fn doppler_sample_interval_and_jitter_near_f32_max_are_rejected() {
     c.jitter_std = [1e30; 3];
     assert!(matches!(c.validate(), Err(Error::InvalidConfig(f)) if f.contains("jitter")));
     // The far-out Doppler path itself no longer overflows: a Doppler of 3e38 Hz.
-    let m = faint::model::doppler::DopplerModel::new(
-        32,
-        0.02,
-        faint::model::doppler::Window::Hamming,
-    )
-    .unwrap();
+    let m =
+        faint::model::doppler::DopplerModel::new(32, 0.02, faint::model::doppler::Window::Hamming)
+            .unwrap();
     let z = vec![Complex32::new(1.0, 0.0); 32];
     for fd in [3e38, -3e38, f32::MAX, -f32::MAX, 1e20] {
         let p = m.project(&z, fd, 1.0);

@@ -4,11 +4,11 @@
 
 use faint::detect::dp::{DpConfig, Method};
 use faint::detect::{Detection, Detector, ScoreKind};
-use faint::rng::Rng;
-use faint::{Error, Result};
 use faint::host::reliability::frames::reals;
 use faint::host::reliability::guided::{self, by_name, run, Spec};
 use faint::host::reliability::Kind;
+use faint::rng::Rng;
+use faint::{Error, Result};
 
 fn names() -> impl Iterator<Item = &'static str> {
     faint::host::detect::REGISTRY.iter().map(|e| e.name)

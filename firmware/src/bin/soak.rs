@@ -36,7 +36,6 @@
 #![no_std]
 #![no_main]
 
-
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
 use faint_core::detect::cbmember::CbmemberTbdSoak;
