@@ -423,7 +423,7 @@ where
             if keep_reports {
                 reports.push(report_json(report));
             }
-            if k % 64 == 0 {
+            if k.is_multiple_of(64) {
                 pb.set_position(k as u64);
             }
             collect += t.elapsed().as_secs_f64();

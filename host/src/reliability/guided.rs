@@ -859,7 +859,7 @@ pub fn to_hex(data: &[u8]) -> String {
 
 /// The bytes of [`to_hex`]'s text.
 pub fn from_hex(s: &str) -> anyhow::Result<Vec<u8>> {
-    anyhow::ensure!(s.len() % 2 == 0, "odd hex length");
+    anyhow::ensure!(s.len().is_multiple_of(2), "odd hex length");
     (0..s.len())
         .step_by(2)
         .map(|i| Ok(u8::from_str_radix(s.get(i..i + 2).unwrap_or("?"), 16)?))

@@ -276,7 +276,7 @@ where
 pub fn case_config(base: &Value, seed: u64, case: u64) -> (Rng, Value, Vec<String>) {
     let mut rng = Rng::from_stream(seed, case);
     let mut v = base.clone();
-    let mutated = if case % 8 == 0 {
+    let mutated = if case.is_multiple_of(8) {
         Vec::new()
     } else {
         mutate::mutate(&mut v, &mut rng)
