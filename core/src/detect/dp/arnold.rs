@@ -724,7 +724,7 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         Ok(())
     }
 
-    fn run(
+    fn recurse(
         &mut self,
         frame: &[f32],
         slow: bool,

@@ -355,7 +355,14 @@ pub trait Recursion: Clone + core::fmt::Debug {
     /// One frame (length and values checked; `slow`: some pixel needs clamping): new
     /// merits and back-pointers, the frame's best into `tally` ([`Tally::advance`]).
     #[doc(hidden)]
-    fn run(&mut self, frame: &[f32], slow: bool, cfg: &DpConfig, quant: &Quant, tally: &mut Tally);
+    fn recurse(
+        &mut self,
+        frame: &[f32],
+        slow: bool,
+        cfg: &DpConfig,
+        quant: &Quant,
+        tally: &mut Tally,
+    );
     /// Stored merit of the best state at pixel `(x, y)`.
     #[doc(hidden)]
     fn raw(&self, x: usize, y: usize) -> Option<i32>;
@@ -463,7 +470,7 @@ impl<R: Recursion> Detector for DpTbd<R> {
     fn step(&mut self, frame: &[f32]) -> Result<DpReport> {
         let slow = begin(self.configured, &self.quant, frame, R::SIDE)?;
         self.kernel
-            .run(frame, slow, &self.cfg, &self.quant, &mut self.tally);
+            .recurse(frame, slow, &self.cfg, &self.quant, &mut self.tally);
         let mut ends = self.ends;
         let kernel = &self.kernel;
         let r = finish(&self.cfg, &self.tally, &mut ends, R::SIDE, |x, y| {

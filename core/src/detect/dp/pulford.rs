@@ -198,7 +198,14 @@ impl<const M: usize, const QB: usize, const L: usize, const W: usize, C: MeritCe
         Ok(())
     }
 
-    fn run(&mut self, frame: &[f32], slow: bool, cfg: &DpConfig, quant: &Quant, tally: &mut Tally) {
+    fn recurse(
+        &mut self,
+        frame: &[f32],
+        slow: bool,
+        cfg: &DpConfig,
+        quant: &Quant,
+        tally: &mut Tally,
+    ) {
         let k = tally.frames + 1;
         let sub = if k == 1 { 0 } else { tally.best_raw };
         let mut clamped = 0u32;
