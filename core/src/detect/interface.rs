@@ -129,12 +129,12 @@ pub trait Validate {
 ///
 /// static DET: Mutex<CrpfTbd1000> = Mutex::new(CrpfTbd1000::new_unconfigured());
 ///
-/// let mut det = DET.lock().unwrap();
+/// let mut det = DET.lock()?; // an error only if another holder panicked
 /// assert!(det.step(&[Complex32::new(0.0, 0.0); 32]).is_err()); // not configured yet
 /// det.configure(&CrpfConfig::othr(), 7)?;
 /// let report = det.step(&[Complex32::new(0.1, -0.2); 32])?;
 /// assert_eq!(report.frame, 1);
-/// # Ok::<(), faint_core::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 ///
 /// On a target without `std` the same constant initialises a `static mut`, a

@@ -56,7 +56,8 @@
 //! use faint_core::detect::Detector;
 //! static mut DET: faint_core::dp_tbd!(Arnold, 32, 9, 8) = faint_core::detect::dp::ArnoldDp::new_unconfigured();
 //! let mut small = <faint_core::dp_tbd!(Pulford, 16, 9, 4)>::new_unconfigured();
-//! small.configure(&DpConfig::dim_point(Method::Pulford, 1), 0).unwrap();
+//! small.configure(&DpConfig::dim_point(Method::Pulford, 1), 0)?;
+//! # Ok::<(), faint_core::Error>(())
 //! ```
 //!
 //! The first order keeps `L - 1` frames of back-pointers, the second order `L - 2` (its
