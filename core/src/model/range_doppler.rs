@@ -415,7 +415,10 @@ impl GaussRun {
     fn next(&mut self) -> f32 {
         let g = self.g;
         self.k += 1;
-        if self.k.is_multiple_of(ANCHOR) {
+        // `%` by the constant, not `is_multiple_of`: on the Cortex-M4F the latter cost the
+        // CBMeMBer steps 0.3-0.4 % more instructions (firmware table, measured).
+        #[allow(clippy::manual_is_multiple_of)]
+        if self.k % ANCHOR == 0 {
             self.anchor(self.u0 + self.k as f32 * self.d);
         } else {
             self.g *= self.q;
