@@ -117,7 +117,10 @@ impl Volatile<'_> {
                 continue;
             }
             let mut cells: Vec<String> = l.split('|').map(|c| c.trim().to_string()).collect();
-            if lines.get(k + 1).is_some_and(|n| n.starts_with("|-") || n.starts_with("| -")) {
+            if lines
+                .get(k + 1)
+                .is_some_and(|n| n.starts_with("|-") || n.starts_with("| -"))
+            {
                 masked = cells
                     .iter()
                     .enumerate()

@@ -1,6 +1,6 @@
 //! `faint reproduce dp` in shards: three shards merged by `faint merge` write the
 //! outputs of the unsharded run (5 target runs per point as 1 + 2 + 2, 100 + 100
-//! noise-only runs as 33 + 33 + 34; Fig. 5 computed by the merge), every CSV and
+//! noise-only runs as 33 + 33 + 34, 4 frames; Fig. 5 computed by the merge), every CSV and
 //! `summary.md` byte for byte but the command line the summary quotes.
 
 use crate::common::temp;
@@ -17,6 +17,8 @@ fn three_shards_merge_into_the_unsharded_run() {
         "5",
         "--snr",
         "2.0:2.5:0.5",
+        "--frames",
+        "4",
     ];
     let command = Volatile {
         markdown: true,

@@ -1,6 +1,6 @@
 //! `faint reproduce mht` in shards: three shards merged by `faint merge` write the outputs
 //! of the unsharded run byte for byte (every CSV and `summary.md`), whatever the shard
-//! sizes (7 scoring trials per lambda as 2 + 2 + 3, 5 clutter-only as 1 + 2 + 2), with
+//! sizes (5 scoring trials per lambda as 1 + 2 + 2, 4 clutter-only as 1 + 1 + 2), with
 //! the model's thresholds and with `gamma_1` calibrated by simulation (computed by every
 //! shard); and a shard of another reproduction is refused by name.
 
@@ -28,9 +28,9 @@ fn three_shards_merge_into_the_unsharded_run() {
         "--lambda",
         "237",
         "--trials",
-        "7",
-        "--null-trials",
         "5",
+        "--null-trials",
+        "4",
         "--seed",
         "3",
     ];
@@ -56,9 +56,9 @@ fn three_shards_with_a_simulated_gamma() {
         "--gamma-from",
         "sim",
         "--calib-periods",
-        "30",
-        "--calib-check",
         "20",
+        "--calib-check",
+        "10",
     ];
     assert_merged_equals_whole_but(&root, &args, 3, None, |o| o.join("shards"), &ALL);
     let calib = std::fs::read_to_string(root.join("sharded").join("calib.csv")).unwrap();
@@ -81,15 +81,31 @@ fn a_shard_of_another_reproduction_is_refused() {
     };
     run(
         &[
-            "reproduce", "mht", "--quick", "--lambda", "80", "--trials", "2", "--null-trials",
-            "2", "--shard", "1/2",
+            "reproduce",
+            "mht",
+            "--quick",
+            "--lambda",
+            "80",
+            "--trials",
+            "2",
+            "--null-trials",
+            "2",
+            "--shard",
+            "1/2",
         ],
         &a,
     );
     run(
         &[
-            "reproduce", "cbmember", "--quick", "--sets", "timing", "--timing-frames", "1",
-            "--shard", "0/2",
+            "reproduce",
+            "cbmember",
+            "--quick",
+            "--sets",
+            "timing",
+            "--timing-frames",
+            "1",
+            "--shard",
+            "0/2",
         ],
         &b,
     );
