@@ -859,6 +859,40 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
     }
 
+    /// Batches of different record types share one shard file ([`Batch::into_values`]);
+    /// merged, each decodes into its own type, bit for bit and in trial order, and a
+    /// one-trial batch lands in exactly one shard (the last).
+    #[test]
+    fn batches_of_different_record_types_join() {
+        let dir = temp("mixed");
+        let run = Run::new("test", &serde_json::json!({"trials": 5})).unwrap();
+        let rows = |r: Range<usize>| -> Vec<Vec<f32>> {
+            r.map(|t| vec![t as f32 / 3.0, f32::NEG_INFINITY]).collect()
+        };
+        for index in 0..3 {
+            let shard = Shard { index, count: 3 };
+            let a = Batch::run("a", 5, Some(shard), |r| Ok::<_, ()>(rows(r))).unwrap();
+            let b = Batch::run("once", 1, Some(shard), |r| {
+                Ok::<_, ()>(r.map(|_| "timed".to_string()).collect::<Vec<_>>())
+            })
+            .unwrap();
+            assert_eq!(b.results.len(), usize::from(index == 2));
+            let batches = [a.into_values().unwrap(), b.into_values().unwrap()];
+            write(&dir, &run, shard, 1.0, &batches).unwrap();
+        }
+        let keys = ["a".to_string(), "once".to_string()];
+        let m = read(std::slice::from_ref(&dir)).unwrap();
+        let b = m.batches(&keys).unwrap();
+        let a: Vec<Vec<f32>> = b.get("a").unwrap();
+        let bits =
+            |v: &[Vec<f32>]| -> Vec<u32> { v.iter().flatten().map(|x| x.to_bits()).collect() };
+        assert_eq!(bits(&a), bits(&rows(0..5)));
+        assert_eq!(b.get::<String>("once").unwrap(), vec!["timed".to_string()]);
+        assert!(b.get::<String>("a").is_err());
+        assert!(m.batches(&keys[..1]).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
     /// The FNV-1a reference values (Fowler, Noll, Vo; the `""` and `"a"` test vectors).
     #[test]
     fn fnv1a64_matches_the_reference_vectors() {
