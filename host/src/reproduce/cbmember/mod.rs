@@ -62,6 +62,9 @@ pub mod paper {
 /// The command name in shard files.
 pub const COMMAND: &str = "reproduce cbmember";
 
+/// The filters of a set for its scene at one SNR.
+type Filters = Box<dyn Fn(&RotorUav) -> Vec<FilterSpec>>;
+
 /// One curve set of the run: its scene per SNR and its filters. Every set runs on the
 /// streams of `seed` (SNR point `j`: `derive_seed(seed, j)`), so sets share their
 /// random numbers.
@@ -70,7 +73,7 @@ struct SetSpec {
     snrs: Vec<f64>,
     seed: u64,
     make: Box<dyn Fn(f64) -> RotorUav>,
-    filters: Box<dyn Fn(&RotorUav) -> Vec<FilterSpec>>,
+    filters: Filters,
 }
 
 impl SetSpec {
