@@ -12,6 +12,8 @@ use crate::instances::phd::HostFilter;
 use crate::shard::ShardArg;
 use crate::simulate::phd::{SixTargets, Variant};
 
+use super::cubes::Cubes;
+
 /// Command-line arguments (shard files keep them, without `--shard`).
 #[derive(clap::Args, Debug, Clone, Serialize, Deserialize)]
 pub struct Args {
@@ -61,6 +63,13 @@ pub struct Args {
     /// Ablation: clutter normalisation `lambda_k` of eq. 20 (preset 1), finite and > 0.
     #[arg(long)]
     pub clutter_lambda: Option<f64>,
+    /// The cubes: `model` (the preset's, drawn from the filter's own model) or
+    /// `physics` (the same targets rendered by the physics simulator: sinc response per
+    /// axis, random phase per frame; same SNR, the peak-cell power of a target at a cell
+    /// centre over the noise power). The filters are the same.
+    #[arg(long, value_enum, default_value_t = Cubes::Model)]
+    #[serde(default)]
+    pub cubes: Cubes,
     /// One shard of the runs (`--shard I/N`, see `faint merge`).
     #[command(flatten)]
     #[serde(skip)]

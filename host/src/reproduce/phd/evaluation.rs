@@ -8,6 +8,7 @@ use faint_core::detect::Detector;
 use faint_core::rng::Rng;
 use serde::Serialize;
 
+use super::cubes::{Cubes, Renderer};
 use crate::instances::phd::HostFilter;
 use crate::montecarlo::run_trial_range;
 use crate::simulate::phd::{SixTargets, Variant};
@@ -56,7 +57,12 @@ pub(super) struct SummaryRow {
     pub(super) ms_per_frame: f64,
 }
 
-fn one_run(sc: &SixTargets, variants: &[Variant], seed_rng: &mut Rng) -> Result<Vec<RunResult>> {
+fn one_run(
+    sc: &SixTargets,
+    render: &Renderer,
+    variants: &[Variant],
+    seed_rng: &mut Rng,
+) -> Result<Vec<RunResult>> {
     let mut truth_rng = seed_rng.fork(1);
     let mut cube_rng = seed_rng.fork(2);
     let truth = sc.truth(&mut truth_rng);
@@ -79,7 +85,7 @@ fn one_run(sc: &SixTargets, variants: &[Variant], seed_rng: &mut Rng) -> Result<
     let mut cube = Vec::new();
     let (c, p) = sc.ospa;
     for frame in &truth {
-        sc.cube(frame, &mut cube_rng, &mut cube);
+        render.frame(sc, frame, &mut cube_rng, &mut cube);
         let tr: Vec<[f64; 2]> = frame.iter().map(|t| [t.state[0], t.state[2]]).collect();
         for (f, r) in filters.iter_mut().zip(res.iter_mut()) {
             let t0 = Instant::now();
@@ -97,17 +103,21 @@ fn one_run(sc: &SixTargets, variants: &[Variant], seed_rng: &mut Rng) -> Result<
     Ok(res)
 }
 
-/// The runs `range` of scene `sc` through `variants` (run `i` on stream `i` of `seed`,
-/// whichever range, or shard, runs it).
+/// The runs `range` of scene `sc` on `cubes` through `variants` (run `i` on stream `i`
+/// of `seed`, whichever range, or shard, runs it; the same truth and cube streams
+/// whatever the cubes).
 pub(super) fn runs(
     sc: &SixTargets,
+    cubes: Cubes,
     variants: &[Variant],
     range: std::ops::Range<usize>,
     seed: u64,
     label: &str,
 ) -> Result<Vec<Vec<RunResult>>> {
-    let all: Vec<Result<Vec<RunResult>>> =
-        run_trial_range(seed, range, label, |_, rng| one_run(sc, variants, rng));
+    let render = Renderer::new(cubes, sc);
+    let all: Vec<Result<Vec<RunResult>>> = run_trial_range(seed, range, label, |_, rng| {
+        one_run(sc, &render, variants, rng)
+    });
     all.into_iter().collect()
 }
 
