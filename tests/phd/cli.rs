@@ -109,6 +109,14 @@ fn counts_and_snrs_are_checked_quick_or_not() {
             "--birth-pair-speed",
         ),
         (
+            &["--quick", "--filter-intensity-db", "-70"][..],
+            "--filter-intensity-db must lie in [-60, 60] dB, got -70",
+        ),
+        (
+            &["--filter-intensity-db", "inf"][..],
+            "--filter-intensity-db",
+        ),
+        (
             &["--quick", "--cubes", "physics", "--runs", "0"][..],
             "--runs must lie in 1..=1000000, got 0",
         ),

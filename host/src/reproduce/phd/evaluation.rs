@@ -4,6 +4,7 @@
 use std::time::Instant;
 
 use anyhow::Result;
+use faint_core::detect::phd::PhdConfig;
 use faint_core::detect::Detector;
 use faint_core::rng::Rng;
 use serde::Serialize;
@@ -60,19 +61,19 @@ pub(super) struct SummaryRow {
 fn one_run(
     sc: &SixTargets,
     render: &Renderer,
-    variants: &[Variant],
+    variants: &[(Variant, PhdConfig)],
     seed_rng: &mut Rng,
 ) -> Result<Vec<RunResult>> {
     let mut truth_rng = seed_rng.fork(1);
     let mut cube_rng = seed_rng.fork(2);
     let truth = sc.truth(&mut truth_rng);
     let mut filters = Vec::new();
-    for &v in variants {
+    for (v, config) in variants {
         // Each algorithm's filter seed depends on the algorithm only (the paper's three
         // keep the seeds of earlier runs whatever `--variants` selects).
-        let i = Variant::EVERY.iter().position(|&x| x == v).unwrap_or(0);
+        let i = Variant::EVERY.iter().position(|x| x == v).unwrap_or(0);
         let seed = seed_rng.fork(10 + i as u64).next_u64();
-        filters.push(crate::instances::boxed::<HostFilter>(&sc.config(v), seed)?);
+        filters.push(crate::instances::boxed::<HostFilter>(config, seed)?);
     }
     let mut res = vec![
         RunResult {
@@ -103,13 +104,13 @@ fn one_run(
     Ok(res)
 }
 
-/// The runs `range` of scene `sc` on `cubes` through `variants` (run `i` on stream `i`
+/// The runs `range` of scene `sc` on `cubes` through `variants` and their filters (run `i` on stream `i`
 /// of `seed`, whichever range, or shard, runs it; the same truth and cube streams
 /// whatever the cubes).
 pub(super) fn runs(
     sc: &SixTargets,
     cubes: Cubes,
-    variants: &[Variant],
+    variants: &[(Variant, PhdConfig)],
     range: std::ops::Range<usize>,
     seed: u64,
     label: &str,

@@ -49,12 +49,17 @@ fn collect(args: &Args, plan: &Plan, shard: Option<Shard>) -> Result<Vec<Batch<V
         .zip(keys(plan))
         .map(|(&snr, key)| {
             let sc = args.scene(snr);
+            let filters: Vec<_> = plan
+                .variants
+                .iter()
+                .map(|&v| (v, args.config(&sc, v)))
+                .collect();
             let seed = args.seed ^ (snr * 1000.0) as u64;
             Batch::run(key, plan.runs, shard, |range| {
                 evaluation::runs(
                     &sc,
                     args.cubes,
-                    &plan.variants,
+                    &filters,
                     range,
                     seed,
                     &format!("phd {snr} dB{}", args.cubes.label()),
