@@ -8,4 +8,5 @@ mod cli;
 #[path = "../common/cli.rs"]
 mod common;
 mod filter;
+mod m4;
 mod spread;

@@ -287,7 +287,7 @@ fn kernels(det: &mut Det, buf: &mut [f32; CELLS]) {
     });
     black_box(r);
     row(
-        "PHD-TBD from_state + the three axes' weights",
+        "PHD-TBD from_state + three PointSpread::axis_weights (17 slots each)",
         n as u32,
         "particle",
         m,
@@ -303,7 +303,7 @@ fn kernels(det: &mut Det, buf: &mut [f32; CELLS]) {
     });
     black_box(r);
     row(
-        "PHD-TBD from_state + for_each_cell (27 products)",
+        "PHD-TBD from_state + PointSpread::for_each_cell (17 slots, 27 products)",
         n as u32,
         "particle",
         m,
