@@ -532,6 +532,42 @@ pub fn exp_neg(x: f32) -> f32 {
     p * f32::from_bits(((n + 127) as u32) << 23)
 }
 
+/// `pi / 2` split so that `k * PIO2_HI` is exact for `|k| < 256` (16 significant bits).
+const PIO2_HI: f32 = f32::from_bits(0x3fc9_0f00);
+const PIO2_LO: f32 = f32::from_bits(0x37da_a221);
+
+/// `(sin x, cos x)` with a few instructions (`math::sin` and `math::cos` reduce their
+/// argument in f64, a software routine on the Cortex-M4F): `x = k pi/2 + r`,
+/// `|r| <= pi/4`, Taylor polynomials of degree 9 (sine) and 8 (cosine), whose first
+/// neglected terms are below `2e-9` and `3e-8`. Absolute error below `3e-7` for
+/// `|x| <= 200` (checked against `f64`); larger and NaN arguments go to `math::sin` /
+/// `math::cos`.
+#[inline]
+pub fn sin_cos(x: f32) -> (f32, f32) {
+    if !(-200.0..=200.0).contains(&x) {
+        return (math::sin(x), math::cos(x));
+    }
+    let t = x * core::f32::consts::FRAC_2_PI;
+    let k = if t < 0.0 {
+        (t - 0.5) as i32
+    } else {
+        (t + 0.5) as i32
+    };
+    let kf = k as f32;
+    let r = (x - kf * PIO2_HI) - kf * PIO2_LO;
+    let r2 = r * r;
+    let sin = r + r
+        * r2
+        * (-1.0 / 6.0 + r2 * (1.0 / 120.0 + r2 * (-1.0 / 5040.0 + r2 * (1.0 / 362_880.0))));
+    let cos = 1.0 + r2 * (-0.5 + r2 * (1.0 / 24.0 + r2 * (-1.0 / 720.0 + r2 * (1.0 / 40_320.0))));
+    match k & 3 {
+        0 => (sin, cos),
+        1 => (cos, -sin),
+        2 => (-sin, -cos),
+        _ => (-cos, sin),
+    }
+}
+
 /// `ln(1 + f)` for `|f| <= sqrt(2) - 1` by the series of `2 atanh(s)`, `s = f / (2 + f)`
 /// (`|s| <= 0.1716`; the first neglected term, `2 s^11 / 11`, is below `7e-10`).
 #[inline(always)]
@@ -900,6 +936,33 @@ mod tests {
         assert_eq!(exp_neg(f32::NEG_INFINITY), 0.0);
         assert_eq!(exp_neg(1.0), math::exp(1.0));
         assert!(exp_neg(f32::NAN).is_nan());
+    }
+
+    /// `sin_cos` against `f64` on `[-200, 200]` (step 1e-3, plus the points where the
+    /// quadrant changes). Tolerance `3e-7` absolute: the polynomials' truncation (below
+    /// 3e-8) plus f32 rounding of the reduction and of Horner's steps (values up to 1,
+    /// a few ulps of 6e-8).
+    #[test]
+    fn sin_cos_matches_f64() {
+        let check = |x: f32| {
+            let (s, c) = sin_cos(x);
+            let (ws, wc) = (x as f64).sin_cos();
+            assert!((s as f64 - ws).abs() <= 3e-7, "sin x={x} got={s} want={ws}");
+            assert!((c as f64 - wc).abs() <= 3e-7, "cos x={x} got={c} want={wc}");
+        };
+        let mut k = -200_000i32;
+        while k <= 200_000 {
+            check(k as f32 * 1e-3);
+            k += 1;
+        }
+        for q in -127..=127 {
+            let x = (q as f32 + 0.5) * core::f32::consts::FRAC_PI_2;
+            for u in [-1i32, 0, 1] {
+                check(f32::from_bits((x.to_bits() as i32 + u) as u32));
+            }
+        }
+        assert_eq!(sin_cos(1.0e6), (math::sin(1.0e6), math::cos(1.0e6)));
+        assert!(sin_cos(f32::NAN).0.is_nan());
     }
 
     #[test]

@@ -3,6 +3,7 @@
 //! the next frame's birth cells.
 
 use super::*;
+use crate::model::power_cube;
 
 /// Maximum number of birth components.
 pub const MAX_BIRTH_COMPONENTS: usize = 4;
@@ -139,7 +140,7 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
                     let az = (g.azimuth_start_deg
                         + (lb as f32 + self.rng.uniform()) * g.azimuth_cell_deg)
                         / DEG_PER_RAD;
-                    let (sb, cb) = (math::sin(az), math::cos(az));
+                    let (sb, cb) = power_cube::sin_cos(az);
                     let mut vt = tang * self.rng.normal();
                     for _ in 0..np.min(4) {
                         let Some(&(pidx, _)) = prev.get(self.rng.below(np as u32) as usize) else {
@@ -206,7 +207,7 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
             let d = g.doppler_start + (jd as f32 + self.rng.uniform()) * g.doppler_cell;
             let az = (g.azimuth_start_deg + (lb as f32 + self.rng.uniform()) * g.azimuth_cell_deg)
                 / DEG_PER_RAD;
-            let (sb, cb) = (math::sin(az), math::cos(az));
+            let (sb, cb) = power_cube::sin_cos(az);
             let vt = tang * self.rng.normal();
             let (vx, vy) = (d * cb - vt * sb, d * sb + vt * cb);
             let inten = self.rng.uniform_range(b.intensity[0], b.intensity[1]);
