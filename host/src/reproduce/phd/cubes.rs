@@ -242,3 +242,62 @@ mod tests {
         assert!((mean - 2.0 * sc.noise_var).abs() < 0.005 * 2.0, "{mean}");
     }
 }
+
+#[cfg(test)]
+mod relation {
+    use crate::physics::cubes::{sinc, REACH};
+
+    /// Means over the sub-cell offset `u` (uniform in `[-1/2, 1/2]`, 10 001 points) of
+    /// one axis' `f(u)`.
+    fn mean(f: impl Fn(f64) -> f64) -> f64 {
+        let n = 10_000;
+        (0..=n).map(|k| f(-0.5 + k as f64 / n as f64)).sum::<f64>() / (n + 1) as f64
+    }
+
+    /// The numbers docs/phd.md relates the two cubes by, from the responses themselves
+    /// (the axes' factors are independent, so a three-axis mean is the cube of one axis'
+    /// mean; a target `u` cells from its cell's centre, the model's `h_i = exp(-(i -
+    /// u)^2 / 2)` on its 3 cells `i = -1, 0, 1`, the sinc `S(i - u)` on 17):
+    /// - the model's energy `sum h^2` over the peak power at a cell centre: 5.02
+    ///   (+7.0 dB); the sinc's `sum S^2` is 1 less what lies beyond 8 cells: 0.965
+    ///   (-0.15 dB), so equal energy is 7.2 dB more peak SNR on the physics cubes;
+    /// - the sinc's peak-cell power, `max_i S(i - u)^2`: 0.463 (-3.34 dB, the straddle
+    ///   loss);
+    /// - the intensity of the one-cell response that fits the sinc response best in
+    ///   least squares on the filter's 27 cells, `(sum h S / sum h^2)^2`: 0.045 of the
+    ///   target power (-13.5 dB), the `--filter-intensity-db -13.5` of the ablation.
+    ///
+    /// Run with `--nocapture` to print them; the bounds are their printed values
+    /// rounded (a quadrature of 10 001 points is exact to far better than 1e-3 here).
+    #[test]
+    fn the_energy_straddle_and_fitted_intensity() {
+        let cells = [-1.0, 0.0, 1.0];
+        let h = |i: f64, u: f64| (-0.5 * (i - u) * (i - u)).exp();
+        let energy = mean(|u| cells.iter().map(|&i| h(i, u).powi(2)).sum()).powi(3);
+        let sinc_energy =
+            mean(|u| (-REACH..=REACH).map(|i| sinc(i as f64 - u).powi(2)).sum()).powi(3);
+        let peak = mean(|u| {
+            (-1..=1)
+                .map(|i| sinc(i as f64 - u).powi(2))
+                .fold(0.0, f64::max)
+        })
+        .powi(3);
+        let fit = mean(|u| {
+            let hs: f64 = cells.iter().map(|&i| h(i, u) * sinc(i - u)).sum();
+            let hh: f64 = cells.iter().map(|&i| h(i, u).powi(2)).sum();
+            (hs / hh).powi(2)
+        })
+        .powi(3);
+        let db = |x: f64| 10.0 * x.log10();
+        eprintln!(
+            "model energy {energy:.3} ({:.2} dB), sinc energy {sinc_energy:.3}, sinc peak {peak:.3} ({:.2} dB), fitted intensity {fit:.4} ({:.2} dB)",
+            db(energy),
+            db(peak),
+            db(fit)
+        );
+        assert!((energy - 5.02).abs() < 0.005, "{energy}");
+        assert!((sinc_energy - 0.965).abs() < 0.001, "{sinc_energy}");
+        assert!((peak - 0.463).abs() < 0.001, "{peak}");
+        assert!((db(fit) + 13.5).abs() < 0.05, "{fit}");
+    }
+}
