@@ -151,7 +151,7 @@ impl Axis {
 
     /// The cells `lo..hi` within the response's reach of the cell holding coordinate `u`,
     /// and their factors: `S(i - u)` (`std = None`) or `exp(-(i - u)^2 / (2 std^2))`.
-    fn spread(&self, u: f64, std: Option<f64>) -> (usize, Vec<f64>) {
+    fn spread(&self, u: f64, std: Option<f64>) -> AxisSpread {
         let c = u.round() as isize;
         let reach = std.map_or(REACH, |s| (6.0 * s).ceil() as isize);
         let lo = (c - reach).max(0);
@@ -184,6 +184,9 @@ impl Axis {
         Ok(())
     }
 }
+
+/// One axis' spread of an echo: its first cell and the factors from there.
+type AxisSpread = (usize, Vec<f64>);
 
 /// The power-cube simulator's parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -384,7 +387,7 @@ impl CubePhysics {
             Response::Gaussian { std } => std.map(Some),
         };
         // Each echo's I and Q and its spread per axis (first cell, factors).
-        let echoes: Vec<(f64, f64, [(usize, Vec<f64>); 3])> = echoes
+        let echoes: Vec<(f64, f64, [AxisSpread; 3])> = echoes
             .iter()
             .map(|&(ak, q)| {
                 let phi = 2.0 * std::f64::consts::PI * f64::from(rng.uniform());
@@ -397,7 +400,7 @@ impl CubePhysics {
             })
             .collect();
         // The echoes whose spread covers the row, with the row's factor `S_r S_d`.
-        let mut row: Vec<(f64, f64, &(usize, Vec<f64>), f64)> = Vec::new();
+        let mut row: Vec<(f64, f64, &AxisSpread, f64)> = Vec::new();
         for i in 0..nr {
             for j in 0..nd {
                 row.clear();
