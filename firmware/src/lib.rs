@@ -19,6 +19,7 @@
 //! different ones.
 #![no_std]
 
+pub mod board;
 pub mod harness;
 pub mod semihosting;
 pub mod soak;
