@@ -11,11 +11,17 @@ the image is linked with the part's memory.x and the stack room the run measured
 that links is kept. With --run-f407 every STM32F407 image that links runs on QEMU
 netduinoplus2 and must print the mps2 image's counts and report hash.
 
-usage: boards/fit.py [--quick] [--cycles] [--run-f407] [--only FAMILY,...]
+A family's configurations are tried largest first; once every part has one that fits,
+the smaller ones are not built. Each configuration's result is kept in
+target/fit/<spec>.json (--cached prints the tables from those files without building;
+delete them after a change to the detectors).
+
+usage: boards/fit.py [--quick] [--cycles] [--run-f407] [--only FAMILY,...] [--cached]
 Run from firmware/. Needs qemu-system-arm, llvm-size; --cycles needs
 target/tools/release/faint-cycles (firmware/README.md, "Cycles").
 """
 
+import json
 import math
 import os
 import re
@@ -151,8 +157,9 @@ def kib(n):
 def main():
     args = sys.argv[1:]
     quick = "--quick" in args
-    with_cycles = "--cycles" in args
+    with_cycles = "--cycles" in args or "--cached" in args
     run_f407 = "--run-f407" in args
+    cached = "--cached" in args
     only = None
     if "--only" in args:
         only = args[args.index("--only") + 1].split(",")
@@ -167,6 +174,19 @@ def main():
             specs = QUICK[family]
         best = {}
         for spec in specs:
+            if len(best) == len(PARTS):
+                break
+            cache = os.path.join(OUT, spec.replace(":", "-") + ".json")
+            if cached:
+                if not os.path.exists(cache):
+                    continue
+                with open(cache) as f:
+                    r = json.load(f)
+                rows.append((family, spec, r))
+                for part in PARTS:
+                    if r["parts"][part]["ok"] and part not in best:
+                        best[part] = (spec, r)
+                continue
             build(spec)
             elf = os.path.join(OUT, spec.replace(":", "-") + ".mps2.elf")
             os.replace(ELF, elf)
@@ -207,6 +227,9 @@ def main():
                 if result["ok"] and part not in best:
                     best[part] = (spec, r)
             rows.append((family, spec, r))
+            if not quick:
+                with open(cache, "w") as f:
+                    json.dump(r, f)
             print(f"fit.py: {spec}: " + ", ".join(
                 f"{k} {'links' if v['ok'] else v['err']}" for k, v in r["parts"].items()), file=sys.stderr)
         fits.append((family, period, source, specs, best))

@@ -4,13 +4,16 @@
 //! (Cortex-M4F) and count what it costs: the board's counters ([`timer`]), the
 //! measurement harness and its Markdown table ([`harness`]), `static` storage for the
 //! large states ([`statics`]), a fixed-capacity string ([`text`]), the run's exits and
-//! command line through semihosting ([`semihosting`]), and the soak loop ([`soak`]).
+//! command line through semihosting ([`semihosting`]), the soak loop ([`soak`]), and the
+//! per-board counter of the `fit` images ([`board`]).
 //!
 //! The binaries (the layout of idsp's embedded tests):
 //! - `src/main.rs`, the instruction table (one module per detector family under
 //!   `src/rows/`) and the golden lines;
 //! - `src/bin/cycles.rs`, the regions of the cycle model (`tools/cycles`);
 //! - `src/bin/soak.rs`, every detector streamed frames without a reset;
+//! - `src/bin/fit.rs`, one detector configuration built for one part's memory map
+//!   (`boards/`, [`board`]);
 //! - `src/bin/panic_never*.rs`, link-time proofs that no panic path survives.
 //!
 //! Each binary picks its panic handler: [`report_panics!`] (print, exit status 1) for
