@@ -17,9 +17,9 @@ use core::fmt::Write;
 use core::hint::black_box;
 use core::sync::atomic::{compiler_fence, AtomicU32, Ordering};
 
-/// Bytes painted below the stack pointer to find a call's peak stack: inside the
-/// boards' 8 KiB stack reserve (`_fit_stack_reserve` in their `memory.x`).
-pub const STACK_WINDOW: usize = 6 * 1024;
+/// Bytes painted below the stack pointer to find a call's peak stack (the soak's window;
+/// never below the end of the statics in RAM, `__euninit`).
+pub const STACK_WINDOW: usize = 16 * 1024;
 const MARGIN: usize = 64;
 
 #[cfg(faint_board = "stm32f407")]
@@ -133,10 +133,15 @@ fn call<R>(f: impl FnOnce() -> R) -> R {
     f()
 }
 
+extern "C" {
+    /// End of `.uninit`, the last statics in RAM below the stack (cortex-m-rt's `link.x`).
+    static __euninit: u32;
+}
+
 #[inline(always)]
 fn raw<R>(f: impl FnOnce() -> R) -> (R, u64, u32) {
     let sp = cortex_m::register::msp::read() as usize;
-    let lo = sp - STACK_WINDOW;
+    let lo = (sp - STACK_WINDOW).max(&raw const __euninit as usize);
     crate::harness::paint(lo, sp - MARGIN);
     compiler_fence(Ordering::SeqCst);
     let t0 = counter::now();
@@ -151,13 +156,15 @@ fn raw<R>(f: impl FnOnce() -> R) -> (R, u64, u32) {
 
 /// Runs `f` once: its result, its count (instructions or cycles, [`UNIT`]; the empty
 /// call's count subtracted) and its peak stack in bytes. Fails (panics) when the stack
-/// reaches the bottom of the painted window.
+/// reaches the bottom of the painted window or the statics.
 #[inline(always)]
 pub fn measure<R>(f: impl FnOnce() -> R) -> (R, u64, u32) {
+    let sp = cortex_m::register::msp::read() as usize;
+    let floor = (sp - STACK_WINDOW).max(&raw const __euninit as usize);
     let (r, n, stack) = raw(f);
     assert!(
-        (stack as usize) < STACK_WINDOW,
-        "peak stack reached the {STACK_WINDOW}-byte window"
+        (stack as usize) < sp - floor,
+        "peak stack reached the bottom of the painted window (or the statics)"
     );
     let base = u64::from(BASELINE.load(Ordering::Relaxed));
     (r, n.saturating_sub(base), stack)

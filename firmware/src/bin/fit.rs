@@ -229,6 +229,17 @@ mod det {
     pub fn run(st: &mut Stats) {
         // SAFETY: one call each; all-zero values are valid (checked above).
         let (det, buf) = unsafe { (zeroed(&raw mut STATE), zeroed(&raw mut FRAME)) };
+        // MHT-TBD's unconfigured value is not all zero bits (its censor and accumulator
+        // start from other values, which `configure` keeps): copy it from flash, where
+        // the image carries it (as the instruction table's image carries it in `.data`),
+        // not through the stack.
+        #[cfg(faint_fit = "mht")]
+        {
+            static INIT: Det = Det::new_unconfigured();
+            // SAFETY: `det` is the only reference to the static; `INIT` is a valid `Det`
+            // in flash; the two do not overlap.
+            unsafe { core::ptr::copy_nonoverlapping(&INIT, &raw mut *det, 1) };
+        }
         sizes(size_of::<Det>(), size_of::<[Plot; PLOTS]>());
         #[cfg(faint_fit = "mht")]
         let cfg = {
