@@ -1,9 +1,11 @@
 //! Puts the board's `memory.x` where cortex-m-rt's `link.x` looks for it, and writes the
 //! `fit` image's configuration.
 //!
-//! - `FAINT_BOARD` unset: `memory.x` (QEMU `mps2-an386`), as always. (It is not at the
-//!   workspace root: the linker looks for `memory.x` in its working directory, the
-//!   workspace root, before the search path, so a file there would override every board.)
+//! - `FAINT_BOARD` unset: `memory.x` (QEMU `mps2-an385`, `an386`, `an500`) for every
+//!   target but the Cortex-M33 (`thumbv8m.main-*`), which runs on `mps2-an505`
+//!   (`targets/mps2-an505/memory.x`). No `memory.x` may sit at the workspace root: the
+//!   linker runs there and looks in its working directory before the search path, so a
+//!   file there would override every board.
 //!   `FAINT_BOARD=<part>`: `boards/<part>/memory.x` (`stm32f407`, `stm32h743`,
 //!   `atsame70q21`), and `cfg(faint_board = "<part>")` for the code.
 //! - `FAINT_FIT=<detector>[:<n>[:<n>...]]` (the `fit` bin; default `crpf:1000`): the
@@ -62,6 +64,7 @@ fn main() {
     }
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=memory.x");
+    println!("cargo:rerun-if-changed=targets");
     println!("cargo:rerun-if-changed=boards");
     let boards: Vec<&str> = BOARDS.iter().map(|b| b.0).collect();
     println!(
@@ -76,7 +79,13 @@ fn main() {
 
     let board = env::var("FAINT_BOARD").unwrap_or_default();
     let sections: &[&str] = if board.is_empty() {
-        fs::copy("memory.x", out.join("memory.x")).expect("copy memory.x into OUT_DIR");
+        let target = env::var("TARGET").unwrap_or_default();
+        let memory = if target.starts_with("thumbv8m.main-") {
+            "targets/mps2-an505/memory.x"
+        } else {
+            "memory.x"
+        };
+        fs::copy(memory, out.join("memory.x")).expect("copy the board's memory.x into OUT_DIR");
         &[]
     } else {
         let Some((_, sections)) = BOARDS.iter().find(|b| b.0 == board) else {

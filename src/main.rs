@@ -218,10 +218,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
         },
         Command::Merge { inputs, out } => {
-            use faint::host::{calibrate, reproduce::crpf};
+            use faint::host::{calibrate, reproduce};
             let m = faint::host::shard::read(&inputs)?;
             match m.run.command.as_str() {
-                crpf::COMMAND => crpf::merge(&m, out.as_deref())?,
+                c if reproduce::COMMANDS.contains(&c) => reproduce::merge(&m, out.as_deref())?,
                 calibrate::COMMAND => {
                     let cal = calibrate::merge(&m, out.as_deref())?;
                     let args: calibrate::Args = m.run.args()?;

@@ -11,6 +11,7 @@
 //! - `src/main.rs`, the instruction table (one module per detector family under
 //!   `src/rows/`) and the golden lines;
 //! - `src/bin/cycles.rs`, the regions of the cycle model (`tools/cycles`);
+//! - `src/bin/golden.rs`, the golden lines alone (the Cortex-M3, M33 and M7 boards);
 //! - `src/bin/soak.rs`, every detector streamed frames without a reset;
 //! - `src/bin/fit.rs`, one detector configuration built for one part's memory map
 //!   (`boards/`, [`board`]);
@@ -29,6 +30,20 @@ pub mod soak;
 pub mod statics;
 pub mod text;
 pub mod timer;
+
+/// Prints one `golden <name> <hex words>` line per case of `faint_golden::cases` through
+/// semihosting (the lines `.ci/run` diffs against the host's).
+pub fn print_golden_lines() {
+    let mut line = text::Text::<1024>::new();
+    faint_golden::cases(&mut |name, words| {
+        line.clear();
+        if faint_golden::write_line(&mut line, name, words).is_err() {
+            cortex_m_semihosting::hprintln!("golden {} <line too long>", name);
+        } else {
+            cortex_m_semihosting::hprintln!("{}", line.as_str());
+        }
+    });
+}
 
 /// Installs the measuring binaries' panic handler and hard-fault handler: print the
 /// message or the exception frame, exit QEMU with status 1.

@@ -15,7 +15,6 @@ use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
 use faint_firmware::harness;
 use faint_firmware::semihosting::exit_success;
-use faint_firmware::text::Text;
 
 /// The instruction table's rows, one module per detector family.
 mod rows {
@@ -52,15 +51,7 @@ fn main() -> ! {
         harness::static_ram()
     );
     hprintln!();
-    let mut line = Text::<1024>::new();
-    faint_golden::cases(&mut |name, words| {
-        line.clear();
-        if faint_golden::write_line(&mut line, name, words).is_err() {
-            hprintln!("golden {} <line too long>", name);
-        } else {
-            hprintln!("{}", line.as_str());
-        }
-    });
+    faint_firmware::print_golden_lines();
     hprintln!("done");
     exit_success()
 }

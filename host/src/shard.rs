@@ -223,6 +223,79 @@ impl<T> Batch<T> {
     }
 }
 
+impl<T: Serialize> Batch<T> {
+    /// The batch with its results as CBOR values: batches of different record types (a
+    /// command's trial loops and its one-off parts) then share one run and one shard file.
+    pub fn into_values(self) -> Result<Batch<ciborium::Value>> {
+        let results = self
+            .results
+            .iter()
+            .map(|r| {
+                ciborium::Value::serialized(r)
+                    .map_err(|e| anyhow::anyhow!("batch {}: cannot encode: {e}", self.key))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Batch {
+            key: self.key,
+            trials: self.trials,
+            first: self.first,
+            results,
+        })
+    }
+}
+
+/// The whole batches of a run by key, each decoded into its own record type: those one
+/// process ran ([`Batches::whole`]) or those `faint merge` joined ([`Merged::batches`]).
+/// A command computes its outputs from them by one code path whichever way they came.
+#[derive(Debug)]
+pub struct Batches {
+    what: String,
+    batches: Vec<Batch<ciborium::Value>>,
+}
+
+impl Batches {
+    /// The batches of an unsharded run.
+    pub fn whole(batches: Vec<Batch<ciborium::Value>>) -> Self {
+        Self {
+            what: "this run".into(),
+            batches,
+        }
+    }
+
+    /// The keys of the batches, in order.
+    pub fn keys(&self) -> Vec<&str> {
+        self.batches.iter().map(|b| b.key.as_str()).collect()
+    }
+
+    /// Checks that the batches are exactly `keys`, in order (the batches the command's
+    /// arguments define).
+    pub fn expect(&self, keys: &[String]) -> Result<()> {
+        let have = self.keys();
+        ensure!(
+            have == keys.iter().map(String::as_str).collect::<Vec<_>>(),
+            "{}: its batches ({}) are not the ones its arguments define ({})",
+            self.what,
+            have.join(", "),
+            keys.join(", ")
+        );
+        Ok(())
+    }
+
+    /// The results of batch `key`, in trial order.
+    pub fn get<T: DeserializeOwned>(&self, key: &str) -> Result<Vec<T>> {
+        let b = self
+            .batches
+            .iter()
+            .find(|b| b.key == key)
+            .ok_or_else(|| anyhow::anyhow!("{}: no batch {key}", self.what))?;
+        b.results
+            .iter()
+            .map(|v| v.deserialized::<T>())
+            .collect::<std::result::Result<Vec<T>, _>>()
+            .map_err(|e| anyhow::anyhow!("{}: batch {key}: unreadable results: {e}", self.what))
+    }
+}
+
 /// What makes shards parts of one run: the command, its arguments and the inputs fixed
 /// before the trials. The arguments and inputs are kept as CBOR, whose floats
 /// round-trip exactly (JSON text would not promise it).
@@ -378,6 +451,40 @@ impl Merged {
             })
             .collect()
     }
+}
+
+impl Merged {
+    /// The joined batches, checked to be exactly `keys` in order, for a command whose
+    /// batches hold different record types ([`Batch::into_values`]).
+    pub fn batches(&self, keys: &[String]) -> Result<Batches> {
+        let b = Batches {
+            what: self.files[0].display().to_string(),
+            batches: self.batches.clone(),
+        };
+        b.expect(keys)?;
+        Ok(b)
+    }
+}
+
+/// Writes a shard of `command` (arguments `args`, fixed inputs `meta`) begun at `t0` to
+/// `dir` and prints where it went and how to merge it: the last step of every sharded
+/// reproduction.
+pub fn finish<T: Serialize>(
+    dir: &Path,
+    run: &Run,
+    shard: Shard,
+    t0: std::time::Instant,
+    batches: &[Batch<T>],
+) -> Result<PathBuf> {
+    let seconds = t0.elapsed().as_secs_f64();
+    let path = write(dir, run, shard, seconds, batches)?;
+    let runs: usize = batches.iter().map(|b| b.results.len()).sum();
+    println!(
+        "shard {shard}: {runs} runs in {seconds:.1} s written to {}; merge with `faint merge {}`",
+        path.display(),
+        dir.display()
+    );
+    Ok(path)
 }
 
 /// The shard files named by `inputs`: each a shard file, or a folder whose
@@ -749,6 +856,40 @@ mod tests {
         let want: Vec<u64> = (0..7).map(|t| value(t).to_bits()).collect();
         assert_eq!(bits, want);
         assert!(m.results::<f64>(&["b".to_string()]).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Batches of different record types share one shard file ([`Batch::into_values`]);
+    /// merged, each decodes into its own type, bit for bit and in trial order, and a
+    /// one-trial batch lands in exactly one shard (the last).
+    #[test]
+    fn batches_of_different_record_types_join() {
+        let dir = temp("mixed");
+        let run = Run::new("test", &serde_json::json!({"trials": 5})).unwrap();
+        let rows = |r: Range<usize>| -> Vec<Vec<f32>> {
+            r.map(|t| vec![t as f32 / 3.0, f32::NEG_INFINITY]).collect()
+        };
+        for index in 0..3 {
+            let shard = Shard { index, count: 3 };
+            let a = Batch::run("a", 5, Some(shard), |r| Ok::<_, ()>(rows(r))).unwrap();
+            let b = Batch::run("once", 1, Some(shard), |r| {
+                Ok::<_, ()>(r.map(|_| "timed".to_string()).collect::<Vec<_>>())
+            })
+            .unwrap();
+            assert_eq!(b.results.len(), usize::from(index == 2));
+            let batches = [a.into_values().unwrap(), b.into_values().unwrap()];
+            write(&dir, &run, shard, 1.0, &batches).unwrap();
+        }
+        let keys = ["a".to_string(), "once".to_string()];
+        let m = read(std::slice::from_ref(&dir)).unwrap();
+        let b = m.batches(&keys).unwrap();
+        let a: Vec<Vec<f32>> = b.get("a").unwrap();
+        let bits =
+            |v: &[Vec<f32>]| -> Vec<u32> { v.iter().flatten().map(|x| x.to_bits()).collect() };
+        assert_eq!(bits(&a), bits(&rows(0..5)));
+        assert_eq!(b.get::<String>("once").unwrap(), vec!["timed".to_string()]);
+        assert!(b.get::<String>("a").is_err());
+        assert!(m.batches(&keys[..1]).is_err());
         let _ = std::fs::remove_dir_all(&dir);
     }
 

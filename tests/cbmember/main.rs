@@ -7,4 +7,7 @@ mod cli;
 #[path = "../common/cli.rs"]
 mod common;
 mod filter;
+#[path = "../common/shards.rs"]
+mod merge;
 mod physical;
+mod shards;

@@ -1,5 +1,6 @@
 //! The equality test every sharded command shares: `n` shards merged by `faint merge`
-//! write the same outputs as one unsharded run, every CSV and JSON file byte for byte.
+//! write the same outputs as one unsharded run, every CSV and JSON file byte for byte
+//! (and, where asked, every Markdown file), wall-clock timing columns aside.
 //! Included with `#[path = "../common/shards.rs"] mod shards;`.
 #![allow(dead_code)]
 
@@ -58,6 +59,97 @@ pub fn assert_merged_equals_whole(
     out_file: Option<&str>,
     shards: impl Fn(&Path) -> PathBuf,
 ) -> usize {
+    assert_merged_equals_whole_but(root, args, n, out_file, shards, &Volatile::default())
+}
+
+/// What differs between two runs of one command by nature, left out of the comparison:
+/// wall-clock timings and the command line a summary quotes.
+#[derive(Debug, Default)]
+pub struct Volatile<'a> {
+    /// Compare the Markdown files (`.md`) too.
+    pub markdown: bool,
+    /// Columns blanked in every CSV file and Markdown table that has them (by header).
+    pub columns: &'a [&'a str],
+    /// Markdown lines starting with one of these are left out.
+    pub lines: &'a [&'a str],
+}
+
+impl Volatile<'_> {
+    /// The text of a CSV file with the volatile columns blanked.
+    fn csv(&self, text: &str) -> String {
+        let mut lines = text.lines();
+        let Some(head) = lines.next() else {
+            return String::new();
+        };
+        let cells = |l: &str| -> Vec<String> { l.split(',').map(str::to_string).collect() };
+        let masked: Vec<usize> = cells(head)
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| self.columns.contains(&c.as_str()))
+            .map(|(i, _)| i)
+            .collect();
+        let mut out = vec![head.to_string()];
+        for l in lines {
+            let mut c = cells(l);
+            for &i in &masked {
+                if let Some(x) = c.get_mut(i) {
+                    x.clear();
+                }
+            }
+            out.push(c.join(","));
+        }
+        out.join("\n")
+    }
+
+    /// The text of a Markdown file with the volatile lines left out and the volatile
+    /// columns of its tables blanked.
+    fn markdown(&self, text: &str) -> String {
+        let lines: Vec<&str> = text.lines().collect();
+        let mut masked: Vec<usize> = Vec::new();
+        let mut out = Vec::new();
+        for (k, l) in lines.iter().enumerate() {
+            if self.lines.iter().any(|p| l.starts_with(p)) {
+                continue;
+            }
+            if !l.starts_with('|') {
+                masked.clear();
+                out.push(l.to_string());
+                continue;
+            }
+            let mut cells: Vec<String> = l.split('|').map(|c| c.trim().to_string()).collect();
+            if lines
+                .get(k + 1)
+                .is_some_and(|n| n.starts_with("|-") || n.starts_with("| -"))
+            {
+                masked = cells
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, c)| self.columns.contains(&c.as_str()))
+                    .map(|(i, _)| i)
+                    .collect();
+            } else {
+                for &i in &masked {
+                    if let Some(x) = cells.get_mut(i) {
+                        x.clear();
+                    }
+                }
+            }
+            out.push(cells.join("|"));
+        }
+        out.join("\n")
+    }
+}
+
+/// [`assert_merged_equals_whole`] leaving out what `volatile` names (the Markdown files
+/// compared too when it says so).
+pub fn assert_merged_equals_whole_but(
+    root: &Path,
+    args: &[&str],
+    n: usize,
+    out_file: Option<&str>,
+    shards: impl Fn(&Path) -> PathBuf,
+    volatile: &Volatile,
+) -> usize {
     let target = |name: &str| match out_file {
         Some(f) => root.join(name).join(f),
         None => root.join(name),
@@ -104,18 +196,36 @@ pub fn assert_merged_equals_whole(
     assert_eq!(a, b, "the merged run wrote other files");
     let mut compared = 0;
     for f in &a {
-        if matches!(f.extension().and_then(|e| e.to_str()), Some("csv" | "json")) {
-            let (x, y) = (
-                std::fs::read(whole.join(f)).unwrap(),
-                std::fs::read(sharded.join(f)).unwrap(),
-            );
-            assert!(
-                x == y,
-                "{} differs between the whole and the merged run",
-                f.display()
-            );
-            compared += 1;
+        let ext = f.extension().and_then(|e| e.to_str());
+        let compared_kind = match ext {
+            Some("csv" | "json") => true,
+            Some("md") => volatile.markdown,
+            _ => false,
+        };
+        if !compared_kind {
+            continue;
         }
+        let (x, y) = (
+            std::fs::read(whole.join(f)).unwrap(),
+            std::fs::read(sharded.join(f)).unwrap(),
+        );
+        let (x, y) = if volatile.columns.is_empty() && volatile.lines.is_empty() {
+            (x, y)
+        } else {
+            let text = |b: Vec<u8>| String::from_utf8(b).expect("UTF-8 output");
+            let f = |t: String| match ext {
+                Some("csv") => volatile.csv(&t),
+                Some("md") => volatile.markdown(&t),
+                _ => t,
+            };
+            (f(text(x)).into_bytes(), f(text(y)).into_bytes())
+        };
+        assert!(
+            x == y,
+            "{} differs between the whole and the merged run",
+            f.display()
+        );
+        compared += 1;
     }
     assert!(compared > 0, "no CSV or JSON output to compare");
     compared

@@ -8,6 +8,9 @@ mod analysis;
 mod cli;
 mod detector;
 mod host;
+#[path = "../common/shards.rs"]
+mod merge;
+mod shards;
 
 #[path = "../common/cli.rs"]
 mod common;

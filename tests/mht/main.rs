@@ -8,7 +8,10 @@ mod cli;
 #[path = "../common/cli.rs"]
 mod common;
 mod detector;
+#[path = "../common/shards.rs"]
+mod merge;
 mod model;
 mod paper_gamma;
+mod shards;
 mod stages;
 mod thresholds;

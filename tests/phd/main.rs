@@ -8,4 +8,7 @@ mod cli;
 #[path = "../common/cli.rs"]
 mod common;
 mod filter;
+#[path = "../common/shards.rs"]
+mod merge;
+mod shards;
 mod spread;

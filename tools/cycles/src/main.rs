@@ -11,7 +11,10 @@
 //! and pipeline refill), `--div 12` (SDIV/UDIV cycles), `--mispredict 4` (M7),
 //! `--hot N` (the N costliest blocks of each region, with their instructions),
 //! `--mca-out DIR` (writes each region's costliest loop block as `DIR/<k>.s` and, when
-//! `llvm-mca` is on the PATH, compares the model with llvm-mca's Cortex-M4 model on it).
+//! `llvm-mca` is on the PATH, compares the model with llvm-mca's Cortex-M4 model on it),
+//! `--streams FILE` (writes one line per region with its traced instructions and a digest
+//! of its executed instruction stream, to compare two runs, e.g. on `mps2-an386` with
+//! `--cpu cortex-m4` and on `mps2-an500` with `--cpu cortex-m7`).
 //! The cost model is in `model.rs`; the trace format in `trace.rs`.
 //!
 //! The firmware brackets each traced region with calls to `faint_cycles_begin` and
@@ -44,11 +47,12 @@ struct Opts {
     m7_mhz: f64,
     hot: usize,
     mca_out: Option<String>,
+    streams: Option<String>,
     p: Params,
 }
 
 fn usage() -> String {
-    "usage: faint-cycles run [--machine M] [--cpu C] [--m4-mhz F] [--m7-mhz F] [--wait-states N] [--div N] [--mispredict N] [--hot N] [--mca-out DIR] <elf> | faint-cycles size <elf>".into()
+    "usage: faint-cycles run [--machine M] [--cpu C] [--m4-mhz F] [--m7-mhz F] [--wait-states N] [--div N] [--mispredict N] [--hot N] [--mca-out DIR] [--streams FILE] <elf> | faint-cycles size <elf>".into()
 }
 
 fn main() -> ExitCode {
@@ -83,6 +87,7 @@ fn parse_opts(args: &[String]) -> Result<(Opts, String), String> {
         m7_mhz: 480.0,
         hot: 0,
         mca_out: None,
+        streams: None,
         p: Params::default(),
     };
     let mut elf = None;
@@ -109,6 +114,7 @@ fn parse_opts(args: &[String]) -> Result<(Opts, String), String> {
             "--mispredict" => o.p.mispredict = num(a, val(a)?)? as u64,
             "--hot" => o.hot = num(a, val(a)?)? as usize,
             "--mca-out" => o.mca_out = Some(val(a)?),
+            "--streams" => o.streams = Some(val(a)?),
             s if s.starts_with("--") => return Err(format!("unknown option {s}; {}", usage())),
             s => elf = Some(s.to_string()),
         }
@@ -169,6 +175,7 @@ fn run(args: &[String]) -> Result<(), String> {
         s
     });
     let mut t = Tracer::new(o.p, o.hot > 0 || o.mca_out.is_some());
+    t.streams = o.streams.is_some();
     let mut other = Vec::new();
     let mut err = BufReader::with_capacity(1 << 20, child.stderr.take().expect("piped stderr"));
     let mut line = String::new();
@@ -198,6 +205,10 @@ fn run(args: &[String]) -> Result<(), String> {
     let status = child.wait().map_err(|e| format!("waiting for qemu: {e}"))?;
     let stdout = reader.join().unwrap_or_default();
     if !status.success() || !stdout.lines().any(|l| l == "done") {
+        // The regions that completed (their lines were printed) still compare.
+        if let (Some(file), Ok(l)) = (&o.streams, labels(&stdout)) {
+            streams(file, &t, &l, &o.machine, &o.cpu)?;
+        }
         return Err(format!(
             "the firmware failed ({status}); its output:\n{stdout}\n{}",
             other.join("\n")
@@ -224,6 +235,9 @@ fn report(o: &Opts, t: &Tracer, stdout: &str) -> Result<(), String> {
     let Some(base) = t.regions.first().filter(|_| labels[0].kind == "base") else {
         return Err("region 0 must be the empty `base` region".into());
     };
+    if let Some(file) = &o.streams {
+        streams(file, t, &labels, &o.machine, &o.cpu)?;
+    }
     let mut failures = Vec::new();
     println!("trace: {} lines", t.lines);
     println!(
@@ -310,6 +324,29 @@ fn report(o: &Opts, t: &Tracer, stdout: &str) -> Result<(), String> {
     } else {
         Err(format!("model check failed:\n  {}", failures.join("\n  ")))
     }
+}
+
+/// Writes one line per region: index, kind, label, traced instructions (the marker calls
+/// included) and the stream digest. Two runs of one image execute the same instructions
+/// in every region when their files are equal. When the firmware fails, the regions it
+/// completed (printed) are written.
+fn streams(
+    file: &str,
+    t: &Tracer,
+    labels: &[Label],
+    machine: &str,
+    cpu: &str,
+) -> Result<(), String> {
+    let mut s = format!(
+        "# executed instruction streams per region (FNV-1a over the addresses), QEMU {machine} {cpu}\n"
+    );
+    for (k, (r, l)) in t.regions.iter().zip(labels).enumerate() {
+        s.push_str(&format!(
+            "{k} | {} | {} | {} | {:016x}\n",
+            l.kind, l.label, r.instructions, r.stream
+        ));
+    }
+    std::fs::write(file, s).map_err(|e| format!("writing {file}: {e}"))
 }
 
 fn ranked(r: &trace::Totals) -> Vec<(usize, u64, u64)> {

@@ -72,12 +72,31 @@ pub struct Totals {
     pub m7: u64,
     /// Executions per block id (only with `hot`).
     pub per_block: HashMap<usize, (u64, u64)>,
+    /// Digest of the executed instruction stream (only with `streams`): FNV-1a (64-bit)
+    /// over the address of every executed instruction, in execution order, so it does
+    /// not depend on where QEMU cut the stream into blocks.
+    pub stream: u64,
+}
+
+/// FNV-1a (64-bit) offset basis and prime.
+const FNV_BASIS: u64 = 0xcbf2_9ce4_8422_2325;
+const FNV_PRIME: u64 = 0x0000_0100_0000_01b3;
+
+/// Folds the 4 little-endian bytes of `addr` into an FNV-1a digest.
+fn fnv_addr(mut h: u64, addr: u32) -> u64 {
+    for b in addr.to_le_bytes() {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(FNV_PRIME);
+    }
+    h
 }
 
 /// The aggregator: feed it the log line by line.
 pub struct Tracer {
     p: Params,
     hot: bool,
+    /// Digest each region's executed instruction stream ([`Totals::stream`]).
+    pub streams: bool,
     blocks: Vec<Block>,
     by_ptr: HashMap<u64, usize>,
     asm: Vec<Insn>,
@@ -101,6 +120,7 @@ impl Tracer {
         Tracer {
             p,
             hot,
+            streams: false,
             blocks: Vec::new(),
             by_ptr: HashMap::new(),
             asm: Vec::new(),
@@ -203,7 +223,10 @@ impl Tracer {
             match self.blocks[prev].marker {
                 Marker::Begin => {
                     self.active = true;
-                    self.regions.push(Totals::default());
+                    self.regions.push(Totals {
+                        stream: FNV_BASIS,
+                        ..Totals::default()
+                    });
                 }
                 Marker::End => self.active = false,
                 Marker::None => {}
@@ -289,6 +312,11 @@ impl Tracer {
             .expect("a region is open when active");
         r.instructions += n;
         r.blocks += 1;
+        if self.streams {
+            for i in &self.blocks[prev].insns[..n as usize] {
+                r.stream = fnv_addr(r.stream, i.addr);
+            }
+        }
         r.m4 = r.m4.wrapping_add(m4).wrapping_add_signed(d4);
         r.m7 = r.m7.wrapping_add(m7).wrapping_add_signed(d7);
         if self.hot {
@@ -412,6 +440,57 @@ Trace 0: 0x7f0000000400 [00000000/00000300/00000110/ff020200] faint_cycles_end
         // 2 + 1 (pipelined) + b (1 + P = 1)
         assert_eq!(run(false), 5);
         assert_eq!(run(true), 5);
+    }
+
+    /// The stream digest is the executed addresses' FNV-1a, whether QEMU cut a block in
+    /// two or not.
+    #[test]
+    fn the_stream_digest_ignores_block_splits() {
+        let run = |split: bool| -> u64 {
+            let mut t = Tracer::new(Params::default(), false);
+            t.streams = true;
+            let mut log = vec![
+                "IN: faint_cycles_begin",
+                "0x00000100:  4770       bx       lr",
+                "Trace 0: 0x10 [00000000/00000100/00000110/ff020200] faint_cycles_begin",
+            ];
+            if split {
+                log.extend([
+                    "IN: x",
+                    "0x00000200:  6820       ldr      r0, [r4]",
+                    "Trace 0: 0x20 [00000000/00000200/00000110/ff020201] x",
+                    "IN: x",
+                    "0x00000202:  6861       ldr      r1, [r4, #4]",
+                    "0x00000204:  e000       b        #0x208",
+                    "Trace 0: 0x28 [00000000/00000202/00000110/ff020200] x",
+                ]);
+            } else {
+                log.extend([
+                    "IN: x",
+                    "0x00000200:  6820       ldr      r0, [r4]",
+                    "0x00000202:  6861       ldr      r1, [r4, #4]",
+                    "0x00000204:  e000       b        #0x208",
+                    "Trace 0: 0x20 [00000000/00000200/00000110/ff020200] x",
+                ]);
+            }
+            log.extend([
+                "IN: faint_cycles_end",
+                "0x00000208:  4770       bx       lr",
+                "Trace 0: 0x30 [00000000/00000208/00000110/ff020200] faint_cycles_end",
+            ]);
+            for l in log {
+                t.line(l);
+            }
+            t.regions[0].stream
+        };
+        // The reference: FNV-1a written out over the bytes of 0x200, 0x202, 0x204.
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for b in [0x00, 0x02, 0, 0, 0x02, 0x02, 0, 0, 0x04, 0x02, 0, 0] {
+            h ^= b;
+            h = h.wrapping_mul(0x100_0000_01b3);
+        }
+        assert_eq!(run(false), h);
+        assert_eq!(run(true), h);
     }
 
     #[test]

@@ -5,11 +5,15 @@ use std::path::PathBuf;
 
 use anyhow::{ensure, Result};
 
+use serde::{Deserialize, Serialize};
+
 use crate::cli;
 use crate::instances::cbmember::MAX_PARTICLES;
+use crate::shard::ShardArg;
 
-/// Command-line arguments of `faint reproduce cbmember`.
-#[derive(clap::Args, Debug, Clone)]
+/// Command-line arguments of `faint reproduce cbmember` (shard files keep them, without
+/// `--shard`).
+#[derive(clap::Args, Debug, Clone, Serialize, Deserialize)]
 pub struct Args {
     /// Monte Carlo runs per SNR point, 1 to 1000000 (default 100; --quick: 2).
     #[arg(long)]
@@ -47,6 +51,10 @@ pub struct Args {
     /// CSV, plots and summary (e.g. the base set at 100 runs, the others at 50).
     #[arg(long)]
     pub previous: Option<PathBuf>,
+    /// One shard of the runs (`--shard I/N`, see `faint merge`).
+    #[command(flatten)]
+    #[serde(skip)]
+    pub shard: ShardArg,
 }
 
 /// Every set name accepted by `--sets`.

@@ -6,12 +6,12 @@ use anyhow::Result;
 use faint_core::detect::cbmember::{CbmemberConfig, Likelihood};
 use faint_core::detect::Detector;
 use faint_core::model::range_doppler::{quantise, Dequant, PointModel};
-use faint_core::rng::{derive_seed, Rng};
+use faint_core::rng::Rng;
 use serde::Serialize;
 
 use crate::instances::boxed;
 use crate::instances::cbmember::{HostFilter, HostFilterU8};
-use crate::montecarlo::run_trials;
+use crate::montecarlo::run_trial_range;
 use crate::simulate::cbmember::{MapSource, RotorUav};
 use crate::stats::detection::{proportion, PdPoint, Proportion};
 use crate::stats::ospa::ospa;
@@ -32,8 +32,8 @@ pub(super) struct FilterSpec {
 }
 
 /// Per run and filter.
-#[derive(Debug, Clone, Copy, Default)]
-struct RunStats {
+#[derive(Debug, Clone, Copy, Default, Serialize, serde::Deserialize)]
+pub(super) struct RunStats {
     hits: usize,
     scored: usize,
     reported: usize,
@@ -165,69 +165,72 @@ fn one_run(sc: &RotorUav, filters: &[FilterSpec], rng: &mut Rng) -> Result<Vec<R
     Ok(stats)
 }
 
-/// Runs one set: for every SNR, `runs` runs of the scenario `make(snr)` with `filters`.
-pub(super) fn run_set(
+/// A set's runs `range` at one SNR point of scene `sc` through `filters`: run `i`
+/// draws from `Rng::from_stream(master, i)`, whichever range (shard) runs it.
+pub(super) fn run_point(
+    sc: &RotorUav,
+    filters: &[FilterSpec],
+    range: std::ops::Range<usize>,
+    master: u64,
+    label: &str,
+) -> Result<Vec<Vec<RunStats>>> {
+    let all: Vec<Result<Vec<RunStats>>> = crate::montecarlo::pool()
+        .install(|| run_trial_range(master, range, label, |_, rng| one_run(sc, filters, rng)));
+    all.into_iter().collect()
+}
+
+/// The rows (one per filter) of a set's SNR point from its runs `all`, summed in run
+/// order.
+pub(super) fn point_rows(
     set: &str,
-    snrs: &[f64],
-    runs: usize,
-    seed: u64,
-    make: &dyn Fn(f64) -> RotorUav,
-    filters: &dyn Fn(&RotorUav) -> Vec<FilterSpec>,
-    pool: &rayon::ThreadPool,
-) -> Result<Vec<Row>> {
+    snr: f64,
+    sc: &RotorUav,
+    fs: &[FilterSpec],
+    all: &[Vec<RunStats>],
+) -> Vec<Row> {
+    let runs = all.len();
     let mut rows = Vec::new();
-    for (j, &snr) in snrs.iter().enumerate() {
-        let sc = make(snr);
-        let fs = filters(&sc);
-        let label = format!("cbmember {set} {snr} dB");
-        let all: Vec<Result<Vec<RunStats>>> = pool.install(|| {
-            run_trials(derive_seed(seed, j as u64), runs, &label, |_, rng| {
-                one_run(&sc, &fs, rng)
-            })
-        });
-        let all: Vec<Vec<RunStats>> = all.into_iter().collect::<Result<_>>()?;
-        for (k, f) in fs.iter().enumerate() {
-            let mut s = RunStats::default();
-            for r in &all {
-                let x = r[k];
-                s.hits += x.hits;
-                s.scored += x.scored;
-                s.reported += x.reported;
-                s.ospa_all += x.ospa_all;
-                s.ospa_burn += x.ospa_burn;
-                s.err_r2 += x.err_r2;
-                s.err_v2 += x.err_v2;
-                s.n_err += x.n_err;
-            }
-            let pd = proportion(s.hits, s.scored);
-            let n_err = s.n_err.max(1) as f64;
-            rows.push(Row {
-                set: set.to_string(),
-                curve: f.name.clone(),
-                snr_db: snr,
-                runs,
-                frames: s.scored,
-                hits: s.hits,
-                pd: pd.p,
-                pd_lo: pd.lo,
-                pd_hi: pd.hi,
-                reported_per_frame: s.reported as f64 / s.scored.max(1) as f64,
-                ospa: s.ospa_all / (runs * sc.frames) as f64,
-                ospa_after_burn_in: s.ospa_burn / s.scored.max(1) as f64,
-                rmse_range_m: if s.n_err > 0 {
-                    (s.err_r2 / n_err).sqrt()
-                } else {
-                    f64::NAN
-                },
-                rmse_velocity_mps: if s.n_err > 0 {
-                    (s.err_v2 / n_err).sqrt()
-                } else {
-                    f64::NAN
-                },
-            });
+    for (k, f) in fs.iter().enumerate() {
+        let mut s = RunStats::default();
+        for r in all {
+            let x = r[k];
+            s.hits += x.hits;
+            s.scored += x.scored;
+            s.reported += x.reported;
+            s.ospa_all += x.ospa_all;
+            s.ospa_burn += x.ospa_burn;
+            s.err_r2 += x.err_r2;
+            s.err_v2 += x.err_v2;
+            s.n_err += x.n_err;
         }
+        let pd = proportion(s.hits, s.scored);
+        let n_err = s.n_err.max(1) as f64;
+        rows.push(Row {
+            set: set.to_string(),
+            curve: f.name.clone(),
+            snr_db: snr,
+            runs,
+            frames: s.scored,
+            hits: s.hits,
+            pd: pd.p,
+            pd_lo: pd.lo,
+            pd_hi: pd.hi,
+            reported_per_frame: s.reported as f64 / s.scored.max(1) as f64,
+            ospa: s.ospa_all / (runs * sc.frames) as f64,
+            ospa_after_burn_in: s.ospa_burn / s.scored.max(1) as f64,
+            rmse_range_m: if s.n_err > 0 {
+                (s.err_r2 / n_err).sqrt()
+            } else {
+                f64::NAN
+            },
+            rmse_velocity_mps: if s.n_err > 0 {
+                (s.err_v2 / n_err).sqrt()
+            } else {
+                f64::NAN
+            },
+        });
     }
-    Ok(rows)
+    rows
 }
 
 pub(super) fn joint(sc: &RotorUav, particles: usize) -> FilterSpec {

@@ -28,12 +28,17 @@ mod evaluation;
 mod summary;
 mod timing;
 
+use std::path::Path;
+
 use anyhow::{Context, Result};
+use faint_core::rng::derive_seed;
 
 use crate::cli;
 use crate::io;
+use crate::shard::{self, Batch, Batches, Merged, Run, Shard};
 use crate::simulate::cbmember::{MapKind, RotorUav};
-use evaluation::{doppler, joint, matched, run_set, FilterSpec, Input};
+use args::Effective;
+use evaluation::{doppler, joint, matched, FilterSpec, Input, RunStats};
 
 pub use args::{Args, SETS};
 pub use evaluation::Row;
@@ -54,107 +59,123 @@ pub mod paper {
     pub const OSPA_SETTLED: f64 = 0.1;
 }
 
-/// Runs the reproduction.
-pub fn run(args: &Args) -> Result<()> {
-    let e = args.effective()?;
-    let pool = crate::montecarlo::pool();
-    let want = |s: &str| e.sets.iter().any(|x| x == s);
-    let d = &args.out;
-    cli::out_dir(d)?;
-    let previous: Vec<Row> = match &args.previous {
-        Some(p) => {
-            let mut r = csv::Reader::from_path(p)
-                .with_context(|| format!("--previous: cannot read {}", p.display()))?;
-            r.deserialize()
-                .collect::<std::result::Result<_, _>>()
-                .with_context(|| format!("--previous: {} is not a curves.csv", p.display()))?
-        }
-        None => Vec::new(),
-    };
-    let mut rows: Vec<Row> = Vec::new();
-    let mut fig11: Vec<usize> = e.particles.clone();
-    fig11.sort_unstable();
-    fig11.dedup();
-    let save = |rows: &[Row]| -> Result<()> { io::write_csv(d.join("curves.csv"), rows) };
+/// The command name in shard files.
+pub const COMMAND: &str = "reproduce cbmember";
 
+/// The filters of a set for its scene at one SNR.
+type Filters = Box<dyn Fn(&RotorUav) -> Vec<FilterSpec>>;
+
+/// One curve set of the run: its scene per SNR and its filters. Every set runs on the
+/// streams of `seed` (SNR point `j`: `derive_seed(seed, j)`), so sets share their
+/// random numbers.
+struct SetSpec {
+    name: String,
+    snrs: Vec<f64>,
+    seed: u64,
+    make: Box<dyn Fn(f64) -> RotorUav>,
+    filters: Filters,
+}
+
+impl SetSpec {
+    fn new(
+        name: &str,
+        snrs: &[f64],
+        seed: u64,
+        make: impl Fn(f64) -> RotorUav + 'static,
+        filters: impl Fn(&RotorUav) -> Vec<FilterSpec> + 'static,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            snrs: snrs.to_vec(),
+            seed,
+            make: Box::new(make),
+            filters: Box::new(filters),
+        }
+    }
+
+    /// The batch key of SNR point `j`.
+    fn key(&self, j: usize) -> String {
+        format!("{} {j}", self.name)
+    }
+}
+
+/// The Fig. 11 particle counts, sorted.
+fn fig11(e: &Effective) -> Vec<usize> {
+    let mut v = e.particles.clone();
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+/// The sets `--sets` selects, in the run's fixed order.
+fn sets(e: &Effective, seed: u64) -> Vec<SetSpec> {
+    let want = |s: &str| e.sets.iter().any(|x| x == s);
+    let mut out = Vec::new();
     if want("base") {
-        let parts = fig11.clone();
-        rows.extend(run_set(
+        let parts = fig11(e);
+        out.push(SetSpec::new(
             "base",
             &e.snrs,
-            e.runs,
-            args.seed,
-            &RotorUav::new,
-            &|sc| {
+            seed,
+            RotorUav::new,
+            move |sc| {
                 let mut v = vec![joint(sc, 1500), doppler(sc, 1500)];
                 v.extend(parts.iter().filter(|&&p| p != 1500).map(|&p| joint(sc, p)));
                 v
             },
-            pool,
-        )?);
-        save(&rows)?;
+        ));
     }
     if want("blades") {
         for b in [3u32, 4] {
-            rows.extend(run_set(
+            out.push(SetSpec::new(
                 &format!("blades {b}"),
                 &e.snrs,
-                e.runs,
-                args.seed,
-                &|s| {
+                seed,
+                move |s| {
                     let mut sc = RotorUav::new(s);
                     sc.blades = b;
                     sc.filter.blades = b;
                     sc
                 },
-                &|sc| vec![joint(sc, 1500)],
-                pool,
-            )?);
+                |sc| vec![joint(sc, 1500)],
+            ));
         }
-        save(&rows)?;
     }
     if want("omega") {
         for w in [0.04, 0.08] {
-            rows.extend(run_set(
+            out.push(SetSpec::new(
                 &format!("omega {w} pi"),
                 &e.snrs,
-                e.runs,
-                args.seed,
-                &|s| {
+                seed,
+                move |s| {
                     let mut sc = RotorUav::new(s);
                     sc.omega = w * std::f64::consts::PI;
                     sc
                 },
-                &|sc| vec![joint(sc, 1500)],
-                pool,
-            )?);
+                |sc| vec![joint(sc, 1500)],
+            ));
         }
-        save(&rows)?;
     }
     if want("fa") {
-        rows.extend(run_set(
+        out.push(SetSpec::new(
             "target-free",
             &e.snrs,
-            e.runs,
-            args.seed ^ 0xFA,
-            &|s| {
+            seed ^ 0xFA,
+            |s| {
                 let mut sc = RotorUav::new(s);
                 sc.present = false;
                 sc
             },
-            &|sc| vec![joint(sc, 1500), doppler(sc, 1500)],
-            pool,
-        )?);
-        save(&rows)?;
+            |sc| vec![joint(sc, 1500), doppler(sc, 1500)],
+        ));
     }
     if want("ablation") {
-        rows.extend(run_set(
+        out.push(SetSpec::new(
             "ablation",
             &e.snrs,
-            e.runs,
-            args.seed,
-            &RotorUav::new,
-            &|sc| {
+            seed,
+            RotorUav::new,
+            |sc| {
                 let mut est = joint(sc, 1500);
                 est.cfg.estimate_blades = true;
                 est.name = "joint 1500 B estimated".into();
@@ -163,68 +184,47 @@ pub fn run(args: &Args) -> Result<()> {
                 q.name = "joint 1500 u8 map".into();
                 vec![est, q]
             },
-            pool,
-        )?);
-        save(&rows)?;
+        ));
     }
     if want("merge") {
         // The narrower merge gate of the first runs, [2 m, 0.5 m/s]: a birth confirmed
         // in one frame 2-3 m behind the receding target is a second report.
-        rows.extend(run_set(
-            "merge",
-            &e.snrs,
-            e.runs,
-            args.seed,
-            &RotorUav::new,
-            &|sc| {
-                let narrow = |mut f: FilterSpec| {
-                    f.cfg.merge_gate = [2.0, 0.5];
-                    f.name = format!("{} merge gate 2 m 0.5 mps", f.name);
-                    f
-                };
-                vec![narrow(joint(sc, 1500)), narrow(doppler(sc, 1500))]
-            },
-            pool,
-        )?);
-        save(&rows)?;
+        out.push(SetSpec::new("merge", &e.snrs, seed, RotorUav::new, |sc| {
+            let narrow = |mut f: FilterSpec| {
+                f.cfg.merge_gate = [2.0, 0.5];
+                f.name = format!("{} merge gate 2 m 0.5 mps", f.name);
+                f
+            };
+            vec![narrow(joint(sc, 1500)), narrow(doppler(sc, 1500))]
+        }));
     }
     if want("known") {
         // The paper's comparison assumes the micro-Doppler parameters known: births with
         // the true V, omega and phase (referenced to frame 0), no V / omega noise.
-        rows.extend(run_set(
-            "known",
-            &e.snrs,
-            e.runs,
-            args.seed,
-            &RotorUav::new,
-            &|sc| {
-                let mut f = joint(sc, 1500);
-                let b = &mut f.cfg.birth;
-                b.blade_speed = [sc.blade_speed as f32; 2];
-                b.omega = [sc.omega as f32; 2];
-                b.theta = [sc.theta0 as f32; 2];
-                b.phase_from_frame0 = true;
-                f.cfg.process.blade_speed = 0.0;
-                f.cfg.process.omega = 0.0;
-                f.name = "joint 1500 micro-Doppler known".into();
-                vec![f]
-            },
-            pool,
-        )?);
-        save(&rows)?;
+        out.push(SetSpec::new("known", &e.snrs, seed, RotorUav::new, |sc| {
+            let mut f = joint(sc, 1500);
+            let b = &mut f.cfg.birth;
+            b.blade_speed = [sc.blade_speed as f32; 2];
+            b.omega = [sc.omega as f32; 2];
+            b.theta = [sc.theta0 as f32; 2];
+            b.phase_from_frame0 = true;
+            f.cfg.process.blade_speed = 0.0;
+            f.cfg.process.omega = 0.0;
+            f.name = "joint 1500 micro-Doppler known".into();
+            vec![f]
+        }));
     }
     if want("physical") {
-        rows.extend(run_set(
+        out.push(SetSpec::new(
             "physical",
             &e.physical_snrs,
-            e.runs,
-            args.seed,
-            &|s| {
+            seed,
+            |s| {
                 let mut sc = RotorUav::new(s);
                 sc.map = MapKind::Physical;
                 sc
             },
-            &|sc| {
+            |sc| {
                 vec![
                     joint(sc, 1500),
                     doppler(sc, 1500),
@@ -232,12 +232,72 @@ pub fn run(args: &Args) -> Result<()> {
                     matched(doppler(sc, 1500)),
                 ]
             },
-            pool,
-        )?);
-        save(&rows)?;
+        ));
     }
-    let timing_rows = if want("timing") {
-        let t = timing::timing(e.timing_frames, args.seed)?;
+    out
+}
+
+/// Key of the Table 3 timing batch: one trial, so one shard (the last) measures it.
+const TIMING: &str = "timing";
+
+/// Every batch of the run, in order: each set's SNR points, then the timing.
+fn keys(e: &Effective, seed: u64) -> Vec<String> {
+    let mut k: Vec<String> = sets(e, seed)
+        .iter()
+        .flat_map(|s| (0..s.snrs.len()).map(|j| s.key(j)).collect::<Vec<_>>())
+        .collect();
+    if e.sets.iter().any(|x| x == "timing") {
+        k.push(TIMING.into());
+    }
+    k
+}
+
+/// The runs of every batch that `shard` holds (all of them for `None`).
+fn collect(
+    args: &Args,
+    e: &Effective,
+    shard: Option<Shard>,
+) -> Result<Vec<Batch<ciborium::Value>>> {
+    let mut out = Vec::new();
+    for set in sets(e, args.seed) {
+        for (j, &snr) in set.snrs.iter().enumerate() {
+            let sc = (set.make)(snr);
+            let fs = (set.filters)(&sc);
+            let label = format!("cbmember {} {snr} dB", set.name);
+            let b = Batch::run(set.key(j), e.runs, shard, |range| {
+                evaluation::run_point(&sc, &fs, range, derive_seed(set.seed, j as u64), &label)
+            })?;
+            out.push(b.into_values()?);
+        }
+    }
+    if e.sets.iter().any(|x| x == "timing") {
+        let b = Batch::run(TIMING, 1, shard, |range| -> Result<Vec<Vec<TimingRow>>> {
+            range
+                .map(|_| timing::timing(e.timing_frames, args.seed))
+                .collect()
+        })?;
+        out.push(b.into_values()?);
+    }
+    Ok(out)
+}
+
+/// The outputs of the run from every batch and the `--previous` rows.
+fn analyse(args: &Args, e: &Effective, batches: &Batches, previous: Vec<Row>) -> Result<()> {
+    batches.expect(&keys(e, args.seed))?;
+    let d = &args.out;
+    cli::out_dir(d)?;
+    let mut rows: Vec<Row> = Vec::new();
+    for set in sets(e, args.seed) {
+        for (j, &snr) in set.snrs.iter().enumerate() {
+            let sc = (set.make)(snr);
+            let fs = (set.filters)(&sc);
+            let all: Vec<Vec<RunStats>> = batches.get(&set.key(j))?;
+            rows.extend(evaluation::point_rows(&set.name, snr, &sc, &fs, &all));
+        }
+    }
+    let timing_rows: Vec<TimingRow> = if e.sets.iter().any(|x| x == "timing") {
+        let t: Vec<Vec<TimingRow>> = batches.get(TIMING)?;
+        let t = t.into_iter().next().unwrap_or_default();
         io::write_csv(d.join("table3.csv"), &t)?;
         t
     } else {
@@ -246,10 +306,56 @@ pub fn run(args: &Args) -> Result<()> {
     // Earlier sets that this run did not redo.
     let ran: Vec<String> = rows.iter().map(|r| r.set.clone()).collect();
     rows.extend(previous.into_iter().filter(|r| !ran.contains(&r.set)));
-    save(&rows)?;
-    charts::charts(d, &rows, &fig11)?;
+    io::write_csv(d.join("curves.csv"), &rows)?;
+    charts::charts(d, &rows, &fig11(e))?;
     let md = summary::summary(&rows, &timing_rows);
     io::write_text(d.join("summary.md"), &md)?;
     println!("{md}");
     Ok(())
+}
+
+/// The rows of `--previous`, read before any run (a shard file keeps them: the merge
+/// does not read the file again).
+fn previous(args: &Args) -> Result<Vec<Row>> {
+    match &args.previous {
+        Some(p) => {
+            let mut r = csv::Reader::from_path(p)
+                .with_context(|| format!("--previous: cannot read {}", p.display()))?;
+            r.deserialize()
+                .collect::<std::result::Result<_, _>>()
+                .with_context(|| format!("--previous: {} is not a curves.csv", p.display()))
+        }
+        None => Ok(Vec::new()),
+    }
+}
+
+/// Runs the reproduction: the whole run, or with `--shard` (or a scheduler's array) one
+/// shard's runs, written to `<out>/shards/` for `faint merge`. Table 3's timing runs in
+/// one shard only (the last).
+pub fn run(args: &Args) -> Result<()> {
+    let e = args.effective()?;
+    let shard = args.shard.resolve()?;
+    cli::out_dir(&args.out)?;
+    let previous = previous(args)?;
+    let t0 = std::time::Instant::now();
+    let batches = collect(args, &e, shard)?;
+    match shard {
+        None => analyse(args, &e, &Batches::whole(batches), previous),
+        Some(s) => {
+            let run = Run::new(COMMAND, args)?.with_meta(&previous)?;
+            shard::finish(&args.out.join("shards"), &run, s, t0, &batches).map(|_| ())
+        }
+    }
+}
+
+/// `faint merge` of `reproduce cbmember` shards: the outputs of the unsharded run,
+/// written where it writes them (under `out` if given, else the run's `--out`).
+pub fn merge(m: &Merged, out: Option<&Path>) -> Result<()> {
+    let mut args: Args = m.run.args()?;
+    if let Some(o) = out {
+        args.out = o.to_path_buf();
+    }
+    let e = args.effective()?;
+    let previous: Vec<Row> = m.run.meta()?;
+    analyse(&args, &e, &m.batches(&keys(&e, args.seed))?, previous)
 }

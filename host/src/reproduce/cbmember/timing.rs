@@ -13,7 +13,7 @@ use crate::instances::cbmember::HostFilter;
 use crate::simulate::cbmember::{MapSource, RotorUav};
 
 /// Table 3 timing row.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub struct TimingRow {
     /// Algorithm.
     pub algorithm: String,

@@ -11,7 +11,7 @@ use crate::simulate::dp::{qb_for, with_dp, DimPoint, Run, Truth, HISTORY, METHOD
 
 /// What one detector showed on one target run, frame by frame (index `n - 1` after `n`
 /// frames).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct Trace {
     /// Best merit of a track ending within `near_px` (Chebyshev) of the true pixel.
     pub near: Vec<f32>,

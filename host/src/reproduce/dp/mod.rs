@@ -21,7 +21,7 @@
 //! pixel centres and the true positions, over the detected runs; the track is recovered
 //! from the best end near the truth (track level) or from the global best (image level).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{ensure, Result};
 use faint_core::detect::dp::{Method, Transition};
@@ -30,17 +30,20 @@ use serde::Serialize;
 use crate::analysis::dp::track_thresholds;
 use crate::cli;
 use crate::io::{self, chart::Series};
-use crate::montecarlo::run_trials;
+use crate::montecarlo::run_trial_range;
+use crate::shard::{self, Batch, Batches, Merged, Run, Shard};
 use crate::simulate::dp::{DimPoint, HISTORY, METHODS};
 use crate::stats::detection::{proportion, threshold_at_pfa, Proportion};
+use serde::Deserialize;
 
 pub mod eval;
 pub mod fig5;
 
 pub use eval::{noise_run, target_run, trace, track_error, Trace, Variant};
 
-/// Command-line arguments of `faint reproduce dp`.
-#[derive(clap::Args, Debug, Clone)]
+/// Command-line arguments of `faint reproduce dp` (shard files keep them, without
+/// `--shard`).
+#[derive(clap::Args, Debug, Clone, Serialize, Deserialize)]
 pub struct Args {
     /// Monte Carlo runs per SNR point and speed, 1 to 1000000 (default 100; --quick: 4).
     #[arg(long)]
@@ -78,6 +81,10 @@ pub struct Args {
     /// 10 frames); never overrides a value given on the command line.
     #[arg(long)]
     pub quick: bool,
+    /// One shard of the runs (`--shard I/N`, see `faint merge`).
+    #[command(flatten)]
+    #[serde(skip)]
+    pub shard: crate::shard::ShardArg,
 }
 
 /// Arguments after the `--quick` defaults.
@@ -342,42 +349,88 @@ struct SpeedResult {
     traces: Vec<Vec<Vec<Trace>>>,
 }
 
-fn run_speed(sc: &DimPoint, e: &Effective, seed: u64, speed: u8) -> Result<SpeedResult> {
+/// The batch keys of one speed: its calibration and check noise-only runs, then its
+/// target runs at each SNR.
+fn speed_keys(e: &Effective, speed: u8) -> Vec<String> {
+    let mut k = vec![format!("{speed} px noise"), format!("{speed} px check")];
+    k.extend((0..e.snrs.len()).map(|j| format!("{speed} px snr {j}")));
+    k
+}
+
+/// Every batch of the run, speed after speed.
+fn keys(e: &Effective) -> Vec<String> {
+    e.speeds.iter().flat_map(|&s| speed_keys(e, s)).collect()
+}
+
+/// The runs of every batch that `shard` holds (all of them for `None`): noise-only runs
+/// on the streams of `DimPoint::calibration_seed` and `check_seed`, target runs on
+/// those of `DimPoint::target_seed` (the same frames at every SNR).
+fn collect(
+    sc: &DimPoint,
+    e: &Effective,
+    seed: u64,
+    shard: Option<Shard>,
+) -> Result<Vec<Batch<ciborium::Value>>> {
     let v = e.variant;
-    let noise = |master: u64, label: &str| -> Result<Vec<Vec<Vec<f32>>>> {
-        run_trials(master, e.noise_runs, label, |_, rng| {
-            noise_run(sc, speed, &v, rng)
-        })
-        .into_iter()
-        .collect()
-    };
-    let cal = noise(
-        DimPoint::calibration_seed(seed, speed),
-        &format!("dp noise {speed} px"),
-    )?;
-    let check = noise(
-        DimPoint::check_seed(seed, speed),
-        &format!("dp check {speed} px"),
-    )?;
+    let mut out = Vec::new();
+    for &speed in &e.speeds {
+        let mut keys = speed_keys(e, speed).into_iter();
+        for (master, label) in [
+            (DimPoint::calibration_seed(seed, speed), "noise"),
+            (DimPoint::check_seed(seed, speed), "check"),
+        ] {
+            let b = Batch::run(
+                keys.next().unwrap_or_default(),
+                e.noise_runs,
+                shard,
+                |range| {
+                    run_trial_range(
+                        master,
+                        range,
+                        &format!("dp {label} {speed} px"),
+                        |_, rng| noise_run(sc, speed, &v, rng),
+                    )
+                    .into_iter()
+                    .collect::<Result<Vec<_>>>()
+                },
+            )?;
+            out.push(b.into_values()?);
+        }
+        for &snr in &e.snrs {
+            let label = format!("dp {speed} px SNR {snr:.2}");
+            let b = Batch::run(keys.next().unwrap_or_default(), e.runs, shard, |range| {
+                run_trial_range(
+                    DimPoint::target_seed(seed, speed),
+                    range,
+                    &label,
+                    |_, rng| target_run(sc, speed, snr, &v, rng),
+                )
+                .into_iter()
+                .collect::<Result<Vec<_>>>()
+            })?;
+            out.push(b.into_values()?);
+        }
+    }
+    Ok(out)
+}
+
+/// Everything measured at one speed, from its batches: the image-level thresholds from
+/// the noise-only runs, the analytic track-level ones, the target runs' traces.
+fn speed_result(sc: &DimPoint, e: &Effective, speed: u8, b: &Batches) -> Result<SpeedResult> {
+    let v = e.variant;
+    let keys = speed_keys(e, speed);
+    let cal: Vec<Vec<Vec<f32>>> = b.get(&keys[0])?;
+    let check: Vec<Vec<Vec<f32>>> = b.get(&keys[1])?;
     let mut thresholds = image_thresholds(&cal, &check, sc.frames)?;
     let qb = v.qb(speed)?;
     for (t, &m) in thresholds.iter_mut().zip(&METHODS) {
         let vt = track_thresholds(&v.config(m, speed), qb, sc.frames, PFA)?;
         t.track = Some(vt.into_iter().map(f64::from).collect());
     }
-    let mut traces = Vec::new();
-    for &snr in &e.snrs {
-        let label = format!("dp {speed} px SNR {snr:.2}");
-        let t: Vec<Vec<Trace>> = run_trials(
-            DimPoint::target_seed(seed, speed),
-            e.runs,
-            &label,
-            |_, rng| target_run(sc, speed, snr, &v, rng),
-        )
-        .into_iter()
+    let traces = keys[2..]
+        .iter()
+        .map(|k| b.get::<Vec<Trace>>(k))
         .collect::<Result<_>>()?;
-        traces.push(t);
-    }
     Ok(SpeedResult {
         speed,
         thresholds,
@@ -688,18 +741,61 @@ fn statements(pts: &[Point], level: Level, speeds: &[u8], snrs: &[f64]) -> Vec<V
     out
 }
 
-/// Runs the reproduction.
-pub fn run(args: &Args) -> Result<()> {
-    let e = args.effective()?;
-    let sc = DimPoint {
+/// The command name in shard files.
+pub const COMMAND: &str = "reproduce dp";
+
+/// The scene of the run.
+fn scene(e: &Effective) -> DimPoint {
+    DimPoint {
         frames: e.frames,
         ..DimPoint::default()
-    };
+    }
+}
+
+/// Runs the reproduction: the whole run, or with `--shard` (or a scheduler's array) one
+/// shard's noise-only and target runs, written to `<out>/shards/` for `faint merge`
+/// (Fig. 5 is computed by the merge).
+pub fn run(args: &Args) -> Result<()> {
+    let e = args.effective()?;
+    let shard = args.shard.resolve()?;
+    cli::out_dir(&args.out)?;
+    let t0 = std::time::Instant::now();
+    let batches = collect(&scene(&e), &e, args.seed, shard)?;
+    match shard {
+        None => analyse(args, &e, &Batches::whole(batches)),
+        Some(s) => shard::finish(
+            &args.out.join("shards"),
+            &Run::new(COMMAND, args)?,
+            s,
+            t0,
+            &batches,
+        )
+        .map(|_| ()),
+    }
+}
+
+/// `faint merge` of `reproduce dp` shards: the outputs of the unsharded run, written
+/// where it writes them (under `out` if given, else the run's `--out`).
+pub fn merge(m: &Merged, out: Option<&Path>) -> Result<()> {
+    let mut args: Args = m.run.args()?;
+    if let Some(o) = out {
+        args.out = o.to_path_buf();
+    }
+    let e = args.effective()?;
+    analyse(&args, &e, &m.batches(&keys(&e))?)
+}
+
+/// The outputs of the run from its batches (Fig. 5 computed here: its runs are not
+/// sharded).
+fn analyse(args: &Args, e: &Effective, batches: &Batches) -> Result<()> {
+    batches.expect(&keys(e))?;
+    let sc = scene(e);
+    let e = e.clone();
     let d = &args.out;
     cli::out_dir(d)?;
     let mut results = Vec::new();
     for &speed in &e.speeds {
-        results.push(run_speed(&sc, &e, args.seed, speed)?);
+        results.push(speed_result(&sc, &e, speed, batches)?);
     }
     let mut th_rows = Vec::new();
     for r in &results {

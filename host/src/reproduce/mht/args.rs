@@ -4,11 +4,14 @@
 
 use std::path::PathBuf;
 
+use serde::{Deserialize, Serialize};
+
 use crate::cli;
+use crate::shard::ShardArg;
 use crate::stats::detection::proportion;
 
-/// Command-line arguments.
-#[derive(clap::Args, Debug, Clone)]
+/// Command-line arguments (shard files keep them, without `--shard`).
+#[derive(clap::Args, Debug, Clone, Serialize, Deserialize)]
 pub struct Args {
     /// Clutter plots per scan, each in (0, 2000] (repeatable).
     #[arg(long = "lambda", num_args = 1.., default_values_t = vec![80.0, 164.0, 237.0, 316.0, 398.0])]
@@ -63,10 +66,14 @@ pub struct Args {
     /// simulated; a result at this floor is flagged), 1 to 255.
     #[arg(long, default_value_t = 3)]
     pub calib_min_gamma: u8,
+    /// One shard of the trials (`--shard I/N`, see `faint merge`).
+    #[command(flatten)]
+    #[serde(skip)]
+    pub shard: ShardArg,
 }
 
 /// `--gamma-from` values.
-#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum GammaFrom {
     /// The `--model` law.
     #[default]
@@ -77,7 +84,7 @@ pub enum GammaFrom {
 
 /// `--calib-rule` values: how a candidate `gamma_1` passes with `k` of `T` clutter-only
 /// periods giving a confirmed track.
-#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum CalibRule {
     /// `k / T <= pfa`.
     #[default]
@@ -97,7 +104,7 @@ impl CalibRule {
 }
 
 /// `--model` values.
-#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum ModelChoice {
     /// Eq. 20-26 as published.
     Paper,

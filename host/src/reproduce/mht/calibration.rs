@@ -16,7 +16,7 @@ use crate::instances::mht::{ANGLE_CELLS, RANGE_CELLS};
 use crate::simulate::mht::SeaClutter;
 
 /// Clutter-only false-track counts per candidate `gamma_1` (index = `gamma_1`).
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct FalseTrackCounts {
     /// Periods simulated.
     pub periods: u64,
@@ -207,10 +207,10 @@ pub fn proportion_ci(k: u64, n: u64) -> (f64, f64, f64) {
 }
 
 /// Calibration / check row (`calib.csv`).
-#[derive(Debug, serde::Serialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct CalibRow {
     lambda: f32,
-    batch: &'static str,
+    batch: String,
     gamma: usize,
     periods: u64,
     periods_with_track: u64,
@@ -225,7 +225,7 @@ fn calib_rows(lambda: f32, batch: &'static str, c: &FalseTrackCounts, rows: &mut
         let (p, lo, hi) = proportion_ci(c.with_track[g], c.periods);
         rows.push(CalibRow {
             lambda,
-            batch,
+            batch: batch.to_string(),
             gamma: g,
             periods: c.periods,
             periods_with_track: c.with_track[g],
@@ -244,7 +244,7 @@ const CHECK_TAG: u64 = 0x6368_6563_6b00_0002;
 const PILOT_TAG: u64 = 0x7069_6c6f_7400_0003;
 
 /// The thresholds of one lambda and, with `--gamma-from sim`, the counts behind `gamma_1`.
-#[derive(Debug)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Gammas {
     /// `gamma_1` used by the trials.
     pub(super) gamma1: usize,

@@ -16,7 +16,7 @@ use crate::simulate::mht::{Origin, SeaClutter, Trial};
 pub const MATCH_TOL: f32 = 60.0;
 
 /// Everything measured in one trial.
-#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 pub struct TrialStats {
     /// Clutter plots over the period.
     pub pre_clutter: u32,
@@ -187,50 +187,45 @@ pub fn evaluate_trial(
     st
 }
 
-/// The scoring trials (`sizes.trials`, targets on) and the clutter-only trials
-/// (`sizes.null_trials`) of lambda number `li` at the thresholds `th`.
+/// The trials `range` of lambda number `li` at the thresholds `th`: scoring trials
+/// (targets on, stream `derive_seed(seed, li)`) or, with `null`, clutter-only trials
+/// (stream `derive_seed(seed, li) ^ 0x6e75_6c6c`). Trial `i` is the same whichever
+/// range (shard) runs it.
 pub(super) fn trials(
     args: &Args,
-    sizes: &Sizes,
     li: usize,
     sc: &SeaClutter,
     th: &Gammas,
-) -> anyhow::Result<(Vec<TrialStats>, Vec<TrialStats>)> {
-    let Sizes {
-        trials,
-        null_trials,
-        ..
-    } = *sizes;
+    null: bool,
+    range: std::ops::Range<usize>,
+) -> anyhow::Result<Vec<TrialStats>> {
     let lambda = sc.lambda;
-    let (sc, g1, gc) = (*sc, th.gamma1, th.gamma_classic);
+    let mut sc = *sc;
+    let (g1, gc) = (th.gamma1, th.gamma_classic);
     let g1u = g1.clamp(1, 255) as u8;
     let gcu = gc.clamp(1, 255) as u8;
     // Surface a configuration error once, before the trials (which cannot report it).
     detectors(&sc, g1u, gcu).map_err(|e| anyhow::anyhow!("lambda {lambda}: {e}"))?;
-    let seed = faint_core::rng::derive_seed(args.seed, li as u64);
-    let res: Vec<TrialStats> =
-        crate::montecarlo::run_trials(seed, trials, &format!("mht lambda={lambda}"), |_, rng| {
+    let mut seed = faint_core::rng::derive_seed(args.seed, li as u64);
+    let label = if null {
+        sc.n_targets = 0;
+        seed ^= 0x6e75_6c6c;
+        format!("null lambda={lambda}")
+    } else {
+        format!("mht lambda={lambda}")
+    };
+    Ok(crate::montecarlo::run_trial_range(
+        seed,
+        range,
+        &label,
+        |_, rng| {
             let Ok((mut m, mut c)) = detectors(&sc, g1u, gcu) else {
                 return TrialStats::default();
             };
             let tr = sc.generate(rng);
             evaluate_trial(&sc, &tr, &mut m, &mut c)
-        });
-    let mut null_sc = sc;
-    null_sc.n_targets = 0;
-    let nres: Vec<TrialStats> = crate::montecarlo::run_trials(
-        seed ^ 0x6e75_6c6c,
-        null_trials,
-        &format!("null lambda={lambda}"),
-        |_, rng| {
-            let Ok((mut m, mut c)) = detectors(&null_sc, g1u, gcu) else {
-                return TrialStats::default();
-            };
-            let tr = null_sc.generate(rng);
-            evaluate_trial(&null_sc, &tr, &mut m, &mut c)
         },
-    );
-    Ok((res, nres))
+    ))
 }
 
 /// Per-lambda summary row.

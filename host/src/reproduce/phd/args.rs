@@ -5,12 +5,15 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 
+use serde::{Deserialize, Serialize};
+
 use crate::cli;
 use crate::instances::phd::HostFilter;
+use crate::shard::ShardArg;
 use crate::simulate::phd::{SixTargets, Variant};
 
-/// Command-line arguments.
-#[derive(clap::Args, Debug, Clone)]
+/// Command-line arguments (shard files keep them, without `--shard`).
+#[derive(clap::Args, Debug, Clone, Serialize, Deserialize)]
 pub struct Args {
     /// SNRs in dB, each in [-60, 60] (default 9,7,5; --quick 9).
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
@@ -58,6 +61,10 @@ pub struct Args {
     /// Ablation: clutter normalisation `lambda_k` of eq. 20 (preset 1), finite and > 0.
     #[arg(long)]
     pub clutter_lambda: Option<f64>,
+    /// One shard of the runs (`--shard I/N`, see `faint merge`).
+    #[command(flatten)]
+    #[serde(skip)]
+    pub shard: ShardArg,
 }
 
 /// What [`Args::effective`] settles: SNRs, runs, algorithms and the scene at each SNR.

@@ -9,12 +9,13 @@ use faint_core::rng::Rng;
 use serde::Serialize;
 
 use crate::instances::phd::HostFilter;
-use crate::montecarlo::run_trials;
+use crate::montecarlo::run_trial_range;
 use crate::simulate::phd::{SixTargets, Variant};
 use crate::stats::ospa::ospa;
 
-/// One run of one variant.
-#[derive(Debug, Clone)]
+/// One run of one variant (`seconds`: the filter's wall time, the one result that is
+/// not reproducible bit for bit).
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub(super) struct RunResult {
     /// `N_hat` per frame.
     counts: Vec<usize>,
@@ -96,16 +97,17 @@ fn one_run(sc: &SixTargets, variants: &[Variant], seed_rng: &mut Rng) -> Result<
     Ok(res)
 }
 
-/// `runs` runs of scene `sc` through `variants` (run `i` on stream `i` of `seed`).
+/// The runs `range` of scene `sc` through `variants` (run `i` on stream `i` of `seed`,
+/// whichever range, or shard, runs it).
 pub(super) fn runs(
     sc: &SixTargets,
     variants: &[Variant],
-    runs: usize,
+    range: std::ops::Range<usize>,
     seed: u64,
     label: &str,
 ) -> Result<Vec<Vec<RunResult>>> {
     let all: Vec<Result<Vec<RunResult>>> =
-        run_trials(seed, runs, label, |_, rng| one_run(sc, variants, rng));
+        run_trial_range(seed, range, label, |_, rng| one_run(sc, variants, rng));
     all.into_iter().collect()
 }
 

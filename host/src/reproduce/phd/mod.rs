@@ -16,42 +16,97 @@ mod charts;
 mod evaluation;
 mod summary;
 
+use std::path::Path;
+
 use anyhow::Result;
 
 use crate::cli;
 use crate::io;
+use crate::shard::{self, Batch, Merged, Run, Shard};
 use args::Plan;
+use evaluation::RunResult;
 
 pub use args::Args;
 
-/// Runs the reproduction.
-pub fn run(args: &Args) -> Result<()> {
-    args.validate()?;
-    let Plan {
-        snrs,
-        runs,
-        variants,
-    } = args.effective()?;
+/// The command name in shard files.
+pub const COMMAND: &str = "reproduce phd";
+
+/// The batches of the run: the runs of each SNR, in `--snr-db` order.
+fn keys(plan: &Plan) -> Vec<String> {
+    (0..plan.snrs.len()).map(|j| format!("snr {j}")).collect()
+}
+
+/// The runs of every SNR that `shard` holds (all of them for `None`); the runs of SNR
+/// `s` draw from the streams of `seed ^ (1000 s)`.
+fn collect(args: &Args, plan: &Plan, shard: Option<Shard>) -> Result<Vec<Batch<Vec<RunResult>>>> {
+    plan.snrs
+        .iter()
+        .zip(keys(plan))
+        .map(|(&snr, key)| {
+            let sc = args.scene(snr);
+            let seed = args.seed ^ (snr * 1000.0) as u64;
+            Batch::run(key, plan.runs, shard, |range| {
+                evaluation::runs(&sc, &plan.variants, range, seed, &format!("phd {snr} dB"))
+            })
+        })
+        .collect()
+}
+
+/// The outputs of the run from the runs of every SNR (in [`keys`] order).
+fn analyse(args: &Args, plan: &Plan, all: Vec<Vec<Vec<RunResult>>>) -> Result<()> {
     cli::out_dir(&args.out)?;
     let mut frames_csv = Vec::new();
     let mut summary = Vec::new();
-    for &snr in &snrs {
+    let d = &args.out;
+    for (&snr, all) in plan.snrs.iter().zip(&all) {
         let sc = args.scene(snr);
-        let label = format!("phd {snr} dB");
-        let seed = args.seed ^ (snr * 1000.0) as u64;
-        let all = evaluation::runs(&sc, &variants, runs, seed, &label)?;
-        let (frames, rows) = evaluation::statistics(&sc, snr, &variants, &all);
-        let d = &args.out;
+        let (frames, rows) = evaluation::statistics(&sc, snr, &plan.variants, all);
         let truth = evaluation::truth_counts(&sc);
-        charts::charts(d, snr, runs, &variants, &truth, &frames)?;
+        charts::charts(d, snr, plan.runs, &plan.variants, &truth, &frames)?;
         frames_csv.extend(frames);
         summary.extend(rows);
-        // Write what we have after every SNR (long runs can be inspected early).
-        io::write_csv(d.join("frames.csv"), &frames_csv)?;
-        io::write_csv(d.join("summary.csv"), &summary)?;
-        io::write_text(d.join("table.md"), &summary::table(&summary))?;
     }
+    io::write_csv(d.join("frames.csv"), &frames_csv)?;
+    io::write_csv(d.join("summary.csv"), &summary)?;
     let md = summary::table(&summary);
+    io::write_text(d.join("table.md"), &md)?;
     println!("{md}");
     Ok(())
+}
+
+/// Runs the reproduction: the whole run, or with `--shard` (or a scheduler's array) one
+/// shard's runs, written to `<out>/shards/` for `faint merge`.
+pub fn run(args: &Args) -> Result<()> {
+    args.validate()?;
+    let plan = args.effective()?;
+    let shard = args.shard.resolve()?;
+    cli::out_dir(&args.out)?;
+    let t0 = std::time::Instant::now();
+    let batches = collect(args, &plan, shard)?;
+    match shard {
+        None => analyse(
+            args,
+            &plan,
+            batches.into_iter().map(|b| b.results).collect(),
+        ),
+        Some(s) => shard::finish(
+            &args.out.join("shards"),
+            &Run::new(COMMAND, args)?,
+            s,
+            t0,
+            &batches,
+        )
+        .map(|_| ()),
+    }
+}
+
+/// `faint merge` of `reproduce phd` shards: the outputs of the unsharded run, written
+/// where it writes them (under `out` if given, else the run's `--out`).
+pub fn merge(m: &Merged, out: Option<&Path>) -> Result<()> {
+    let mut args: Args = m.run.args()?;
+    if let Some(o) = out {
+        args.out = o.to_path_buf();
+    }
+    let plan = args.effective()?;
+    analyse(&args, &plan, m.results(&keys(&plan))?)
 }
