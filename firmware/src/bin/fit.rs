@@ -16,8 +16,10 @@
 //! cycle model's markers, so `faint-cycles run` costs this image too. Output: one
 //! `region` line per measured frame, then
 //! `fit | <spec> | <board> | <frames> | <mean> | <worst> | <stack> | <hash>`: the count
-//! per frame (mean and worst), the peak stack and a hash of the reports' `Debug` text
-//! (equal on every board that runs the image).
+//! per frame (mean and worst), the step's peak stack and a hash of the reports' `Debug`
+//! text (equal on every board that runs the image); then `fit stack | run <B> | ...`, the
+//! whole run's deepest stack below its top (set-up, frame generation and steps, each
+//! measured where it runs).
 #![no_std]
 #![no_main]
 
@@ -63,8 +65,9 @@ struct Stats {
     sum: u64,
     worst: u64,
     stack: u32,
-    /// Deepest stack below its top of the set-up and unmeasured calls ([`Stats::setup`]).
-    setup: usize,
+    /// Deepest stack below its top of every call measured (steps, and the set-up and
+    /// unmeasured calls of [`Stats::setup`]).
+    deepest: usize,
     hash: Fnv,
 }
 
@@ -75,7 +78,7 @@ impl Stats {
             sum: 0,
             worst: 0,
             stack: 0,
-            setup: 0,
+            deepest: 0,
             hash: Fnv::new(),
         }
     }
@@ -85,15 +88,15 @@ impl Stats {
     /// caller, which erases the marks of deeper set-up calls made before it, so every
     /// call whose stack counts for the run is measured where it runs.
     fn setup<R>(&mut self, f: impl FnOnce() -> R) -> R {
-        let top = &raw const _stack_start as usize;
         let sp = cortex_m::register::msp::read() as usize;
         let (r, _, stack) = board::measure(f);
-        self.setup = self.setup.max(top - sp + stack as usize);
+        self.deepest = self.deepest.max(depth(sp, stack));
         r
     }
 
     /// Measures one `step` (with the markers) and prints its `region` line.
     fn step<R: Debug>(&mut self, label: &str, k: usize, f: impl FnOnce() -> R) -> R {
+        let sp = cortex_m::register::msp::read() as usize;
         let (r, n, stack) = board::measure(|| {
             faint_cycles_begin();
             let r = f();
@@ -105,6 +108,7 @@ impl Stats {
         self.sum += n;
         self.worst = self.worst.max(n);
         self.stack = self.stack.max(stack);
+        self.deepest = self.deepest.max(depth(sp, stack));
         self.hash.fold(&r);
         r
     }
@@ -130,6 +134,11 @@ impl Stats {
     }
 }
 
+/// Depth below the stack's top of a call measured at `sp` that used `stack` bytes.
+fn depth(sp: usize, stack: u32) -> usize {
+    (&raw const _stack_start as usize) - sp + stack as usize
+}
+
 /// Zeroes a NOLOAD static and hands out its only `&mut`.
 ///
 /// # Safety
@@ -142,13 +151,16 @@ unsafe fn zeroed<T>(p: *mut MaybeUninit<T>) -> &'static mut T {
     }
 }
 
-/// Sizes of the state and the frame, printed for the tables.
-fn sizes(state: usize, frame: usize) {
+/// Sizes of the state, the frame and the harness's statics that go with the frame (the
+/// CRPF family's frame-generation model; 0 for the others), printed for the tables.
+fn sizes(state: usize, frame: usize, harness: usize) {
     hprintln!(
-        "fit sizes | state {} B in {} | frame {} B in {} |",
+        "fit sizes | state {} B in {} | frame {} B in {} | harness {} B in {} |",
         state,
         fit::SECTIONS[0],
         frame,
+        fit::SECTIONS[1],
+        harness,
         fit::SECTIONS[1]
     );
 }
@@ -182,9 +194,11 @@ mod det {
 
     state_static! { static mut STATE: MaybeUninit<Det> = MaybeUninit::uninit(); }
     frame_static! { static mut FRAME: MaybeUninit<[Complex32; 32]> = MaybeUninit::uninit(); }
-    /// The harness's model of the frames it generates (not the detector's: harness RAM,
-    /// in `.bss`), built in place rather than on the stack.
-    static mut FRAME_MODEL: DopplerModel = DopplerModel::new_empty();
+    // The harness's model of the frames it generates (not the detector's), built in place
+    // rather than on the stack, in the frame's section: on the STM32F407 the frame and
+    // this model can go to CCM together and leave the RAM to the detector.
+    frame_static! { static mut FRAME_MODEL: MaybeUninit<DopplerModel> = MaybeUninit::uninit(); }
+    const _: DopplerModel = unsafe { MaybeUninit::zeroed().assume_init() };
 
     /// `src/rows/crpf.rs`'s seeds: `SEEDS` detector seeds on the golden frames 0..=8,
     /// frames 1, 6 and 8 measured (CRPF-TBD's rows over 32 seeds; the comparators the same).
@@ -194,10 +208,18 @@ mod det {
 
     pub fn run(st: &mut Stats) {
         // SAFETY: one call each; all-zero values are valid (checked above).
-        let (det, z) = unsafe { (zeroed(&raw mut STATE), zeroed(&raw mut FRAME)) };
-        sizes(size_of::<Det>(), size_of::<[Complex32; 32]>());
-        // SAFETY: the only reference to the static.
-        let model = unsafe { faint_firmware::statics::only_ref(&raw mut FRAME_MODEL) };
+        let (det, z, model) = unsafe {
+            (
+                zeroed(&raw mut STATE),
+                zeroed(&raw mut FRAME),
+                zeroed(&raw mut FRAME_MODEL),
+            )
+        };
+        sizes(
+            size_of::<Det>(),
+            size_of::<[Complex32; 32]>(),
+            size_of::<DopplerModel>(),
+        );
         check(st.setup(|| model.build_into(32, 0.02, Window::Hamming)));
         for s in 0..SEEDS {
             #[cfg(faint_fit = "crpf")]
@@ -260,7 +282,7 @@ mod det {
             // in flash; the two do not overlap.
             unsafe { core::ptr::copy_nonoverlapping(&INIT, &raw mut *det, 1) };
         }
-        sizes(size_of::<Det>(), size_of::<[Plot; PLOTS]>());
+        sizes(size_of::<Det>(), size_of::<[Plot; PLOTS]>(), 0);
         #[cfg(faint_fit = "mht")]
         let cfg = {
             let mut c = faint_core::detect::mht::MhtConfig::sea_clutter();
@@ -328,7 +350,7 @@ mod det {
         const SEED: u64 = 0x0002_0019_9E1D_7BD0;
         // SAFETY: one call each; all-zero values are valid (checked above).
         let (det, buf) = unsafe { (zeroed(&raw mut STATE), zeroed(&raw mut FRAME)) };
-        sizes(size_of::<Det>(), size_of::<[f32; CELLS]>());
+        sizes(size_of::<Det>(), size_of::<[f32; CELLS]>(), 0);
         #[cfg(faint_fit = "phd")]
         let alg = ALGORITHMS[0];
         #[cfg(faint_fit = "pso-phd")]
@@ -370,7 +392,7 @@ mod det {
         const SEED: u64 = 0x0003_CB3E_3BE7_2023;
         // SAFETY: one call each; all-zero values are valid (checked above).
         let (det, z) = unsafe { (zeroed(&raw mut STATE), zeroed(&raw mut FRAME)) };
-        sizes(size_of::<Det>(), size_of::<[Cell; PIXELS]>());
+        sizes(size_of::<Det>(), size_of::<[Cell; PIXELS]>(), 0);
         let g = faint_core::detect::cbmember::CbmemberConfig::rotor_uav().geometry;
         let cfg = config(g, PointModel::Joint, N, 450);
         check(st.setup(|| det.configure(&cfg, SEED)));
@@ -452,7 +474,7 @@ mod det {
         use faint_core::detect::Detector;
         // SAFETY: one call each; all-zero values are valid (checked above).
         let (det, image) = unsafe { (zeroed(&raw mut STATE), zeroed(&raw mut FRAME)) };
-        sizes(size_of::<Det>(), size_of::<[f32; M * M]>());
+        sizes(size_of::<Det>(), size_of::<[f32; M * M]>(), 0);
         #[cfg(faint_fit = "dp-first")]
         let method = Method::Arnold;
         #[cfg(faint_fit = "dp-pulford")]
@@ -523,7 +545,7 @@ fn main() -> ! {
     let run = top - faint_firmware::harness::lowest_touched(lo, sp - 256);
     hprintln!(
         "fit stack | run {} B | step {} B | room {} B |",
-        run.max(st.stack as usize).max(st.setup),
+        run.max(st.deepest),
         st.stack,
         top - lo
     );
