@@ -8,6 +8,7 @@ mod cli;
 #[path = "../common/cli.rs"]
 mod common;
 mod filter;
+mod m4;
 #[path = "../common/shards.rs"]
 mod merge;
 mod shards;

@@ -55,7 +55,7 @@ impl RadarCoords {
     /// Radar coordinates of the CV state `[x, vx, y, vy, ..]` (radar at the origin).
     #[inline]
     pub fn from_state(x: f32, vx: f32, y: f32, vy: f32) -> Self {
-        let r = math::sqrt(x * x + y * y);
+        let r = sqrt(x * x + y * y);
         let d = if r > 1e-6 { (x * vx + y * vy) / r } else { 0.0 };
         Self {
             range: r,
@@ -379,24 +379,36 @@ impl PointSpread {
     /// (bit-identical to `for_each_cell`).
     #[inline]
     pub fn axis_weights(&self, a: usize, frac: f32, n: usize) -> AxisWeights {
-        let mut out = AxisWeights::NONE;
+        self.axis_weights_in(a, frac, n)
+    }
+
+    /// [`PointSpread::axis_weights`] into `S` slots (the first `S` covered cells; the
+    /// likelihood uses `S = 3` for half widths of at most 1, which spares it clearing
+    /// and copying 17 slots per axis).
+    #[inline(always)]
+    fn axis_weights_in<const S: usize>(&self, a: usize, frac: f32, n: usize) -> AxisWeightsN<S> {
+        let mut out = AxisWeightsN::<S>::NONE;
         if !frac.is_finite() {
             return out;
         }
-        let loss = self.loss(a);
-        let w = self.half(a) as i64;
-        let span = 2 * w as usize + 1;
-        out.span = span;
-        // Clamp so that far-away states do not overflow the i64 conversion.
-        let centre = math::floor(frac.clamp(-1.0e6, 1.0e6)) as i64;
-        for k in 0..span.min(MAX_SPAN) {
-            let i = centre - w + k as i64;
-            if i >= 0 && (i as usize) < n {
-                let delta = i as f32 + 0.5 - frac;
-                out.h[k] = math::exp(-0.5 * loss * delta * delta);
-                out.id[k] = i as usize;
+        let half_loss = 0.5 * self.loss(a);
+        let w = self.half(a) as i32;
+        // Clamp so that far-away states do not overflow the i32 conversion (i32, not
+        // i64: the M4 converts an i64 to f32 in software).
+        let centre = math::floor(frac.clamp(-1.0e6, 1.0e6)) as i32;
+        // The covered cells inside the axis are one run `first..=last`.
+        let first = (centre - w).max(0);
+        let last = (centre + w).min(n.min(1 << 24) as i32 - 1);
+        let mut k = 0usize;
+        for i in first..=last {
+            let delta = i as f32 + 0.5 - frac;
+            if let Some(h) = out.h.get_mut(k) {
+                *h = exp_neg(-half_loss * delta * delta);
+                k += 1;
             }
         }
+        out.lo = first.max(0) as usize;
+        out.len = k;
         out
     }
 
@@ -412,21 +424,12 @@ impl PointSpread {
         b: &AxisWeights,
         mut f: impl FnMut(usize, f32),
     ) {
-        let sb = b.span.min(MAX_SPAN);
-        for (&ir, &hr) in r.id.iter().zip(&r.h).take(r.span) {
-            if ir == usize::MAX {
-                continue;
-            }
-            for (&jd, &hd) in d.id.iter().zip(&d.h).take(d.span) {
-                if jd == usize::MAX {
-                    continue;
-                }
+        for (ir, &hr) in (r.lo..).zip(r.weights()) {
+            for (jd, &hd) in (d.lo..).zip(d.weights()) {
                 let hab = hr * hd;
-                let base = (ir * g.n_doppler + jd) * g.n_azimuth;
-                for (&l, &h) in b.id[..sb].iter().zip(&b.h[..sb]) {
-                    if l != usize::MAX {
-                        f(base + l, hab * h);
-                    }
+                let base = (ir * g.n_doppler + jd) * g.n_azimuth + b.lo;
+                for (l, &h) in b.weights().iter().enumerate() {
+                    f(base + l, hab * h);
                 }
             }
         }
@@ -435,42 +438,236 @@ impl PointSpread {
 
 /// Covered cells and weights of one axis of a [`PointSpread`] (see
 /// [`PointSpread::axis_weights`]).
+pub type AxisWeights = AxisWeightsN<MAX_SPAN>;
+
+/// Covered cells and weights of one axis, in at most `S` slots ([`AxisWeights`]: all
+/// `2 w + 1` of the widest spread).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AxisWeights {
-    h: [f32; MAX_SPAN],
-    /// Cell index per slot, `usize::MAX` outside the axis.
-    id: [usize; MAX_SPAN],
-    /// Slots in use, `2 w + 1`.
-    span: usize,
+pub struct AxisWeightsN<const S: usize> {
+    /// Weights of the covered cells `lo..lo + len` (those inside the axis).
+    h: [f32; S],
+    /// First covered cell.
+    lo: usize,
+    /// Covered cells inside the axis, at most `2 w + 1`.
+    len: usize,
 }
 
-impl AxisWeights {
+impl<const S: usize> AxisWeightsN<S> {
     /// No covered cell.
     pub const NONE: Self = Self {
-        h: [0.0; MAX_SPAN],
-        id: [usize::MAX; MAX_SPAN],
-        span: 0,
+        h: [0.0; S],
+        lo: 0,
+        len: 0,
     };
+
+    /// The weights of the covered cells, in cell order.
+    #[inline]
+    fn weights(&self) -> &[f32] {
+        self.h.get(..self.len).unwrap_or(&[])
+    }
+}
+
+/// `sqrt(x)`, correctly rounded: the FPU's `VSQRT.F32` on the Cortex-M4F (three
+/// instructions with the moves; the portable `math::sqrt` is a software routine of
+/// about 57 there), the
+/// portable `math::sqrt` elsewhere. Both are IEEE 754 square roots, so the results are
+/// the same bits (the golden lines check it).
+#[cfg(faint_m4_asm)]
+#[allow(unsafe_code)]
+#[inline(always)]
+pub fn sqrt(x: f32) -> f32 {
+    let r: u32;
+    // SAFETY: moves between a core register and s0 (declared clobbered) and one
+    // `vsqrt.f32`: no memory, stack or flags touched.
+    unsafe {
+        core::arch::asm!(
+            "vmov s0, {x}",
+            "vsqrt.f32 s0, s0",
+            "vmov {r}, s0",
+            x = in(reg) x.to_bits(),
+            r = lateout(reg) r,
+            out("s0") _,
+            options(pure, nomem, nostack, preserves_flags)
+        );
+    }
+    f32::from_bits(r)
+}
+
+/// `sqrt(x)`, correctly rounded (the portable `math::sqrt`; the Cortex-M4F build uses
+/// the FPU's `VSQRT.F32`, which gives the same bits).
+#[cfg(not(faint_m4_asm))]
+#[inline(always)]
+pub fn sqrt(x: f32) -> f32 {
+    math::sqrt(x)
+}
+
+/// `ln(2)` split so that `e * LN2_HI` is exact for every `f32` exponent `e` (the split
+/// of musl's `logf`: `0.693138122..` with 7 trailing zero bits, and the rest).
+const LN2_HI: f32 = f32::from_bits(0x3f31_7180);
+const LN2_LO: f32 = f32::from_bits(0x3717_f7d1);
+
+/// `e^x` for `x <= 0` with a few instructions: `x = n ln 2 + r`, `|r| <= ln(2) / 2`,
+/// `e^r` by its Taylor polynomial of degree 6 (the first neglected term, `r^7 / 7!`, is
+/// below `1.3e-7` relative), scaled by `2^n` through the exponent bits. Relative error
+/// below `4e-7` on `[-87, 0]` (checked against `f64::exp`); `x < -87` gives 0 (the
+/// true value is below `1.7e-38`); positive and NaN arguments go to `math::exp`.
+/// For the non-positive exponents of the point spread's weights, the weight
+/// normalisation and the swarm's fitness.
+#[inline]
+pub fn exp_neg(x: f32) -> f32 {
+    if x > 0.0 || x.is_nan() {
+        return math::exp(x);
+    }
+    if x < -87.0 {
+        return 0.0;
+    }
+    // n = round(x / ln 2) in [-126, 0].
+    let n = -((0.5 - x * core::f32::consts::LOG2_E) as i32);
+    let nf = n as f32;
+    let r = (x - nf * LN2_HI) - nf * LN2_LO;
+    let p = 1.0
+        + r * (1.0
+            + r * (0.5
+                + r * (1.0 / 6.0 + r * (1.0 / 24.0 + r * (1.0 / 120.0 + r * (1.0 / 720.0))))));
+    p * f32::from_bits(((n + 127) as u32) << 23)
+}
+
+/// `pi / 2` split so that `k * PIO2_HI` is exact for `|k| < 256` (16 significant bits).
+const PIO2_HI: f32 = f32::from_bits(0x3fc9_0f00);
+const PIO2_LO: f32 = f32::from_bits(0x37da_a221);
+
+/// `(sin x, cos x)` with a few instructions (`math::sin` and `math::cos` reduce their
+/// argument in f64, a software routine on the Cortex-M4F): `x = k pi/2 + r`,
+/// `|r| <= pi/4`, Taylor polynomials of degree 9 (sine) and 8 (cosine), whose first
+/// neglected terms are below `2e-9` and `3e-8`. Absolute error below `3e-7` for
+/// `|x| <= 200` (checked against `f64`); larger and NaN arguments go to `math::sin` /
+/// `math::cos`.
+#[inline]
+pub fn sin_cos(x: f32) -> (f32, f32) {
+    if !(-200.0..=200.0).contains(&x) {
+        return (math::sin(x), math::cos(x));
+    }
+    let t = x * core::f32::consts::FRAC_2_PI;
+    let k = if t < 0.0 {
+        (t - 0.5) as i32
+    } else {
+        (t + 0.5) as i32
+    };
+    let kf = k as f32;
+    let r = (x - kf * PIO2_HI) - kf * PIO2_LO;
+    let r2 = r * r;
+    let sin = r + r
+        * r2
+        * (-1.0 / 6.0 + r2 * (1.0 / 120.0 + r2 * (-1.0 / 5040.0 + r2 * (1.0 / 362_880.0))));
+    let cos = 1.0 + r2 * (-0.5 + r2 * (1.0 / 24.0 + r2 * (-1.0 / 720.0 + r2 * (1.0 / 40_320.0))));
+    match k & 3 {
+        0 => (sin, cos),
+        1 => (cos, -sin),
+        2 => (-sin, -cos),
+        _ => (-cos, sin),
+    }
+}
+
+/// `ln(1 + f)` for `|f| <= sqrt(2) - 1` by the series of `2 atanh(s)`, `s = f / (2 + f)`
+/// (`|s| <= 0.1716`; the first neglected term, `2 s^11 / 11`, is below `7e-10`).
+#[inline(always)]
+fn ln1p_reduced(f: f32) -> f32 {
+    let s = f / (2.0 + f);
+    let s2 = s * s;
+    let p = s2
+        * (2.0 / 3.0 + s2 * (2.0 / 5.0 + s2 * (2.0 / 7.0 + s2 * (2.0 / 9.0 + s2 * (2.0 / 11.0)))));
+    2.0 * s + s * p
+}
+
+/// `ln(y)` for `y > 0` with a few instructions: `y = 2^e m`, `m` in
+/// `[sqrt(1/2), sqrt(2))`, `ln y = e ln 2 + ln m` ([`ln1p_reduced`]). Absolute error
+/// below `4e-7` for `y` in `[2^-126, 2^128)` (f32 rounding; checked against `f64::ln`);
+/// subnormal, zero, infinite and NaN arguments go to `math::ln`.
+#[inline]
+pub fn ln_fast(y: f32) -> f32 {
+    if !(f32::MIN_POSITIVE..=f32::MAX).contains(&y) {
+        return math::ln(y);
+    }
+    let b = y.to_bits();
+    let mut e = (b >> 23) as i32 - 127;
+    let mut m = f32::from_bits((b & 0x007f_ffff) | 0x3f80_0000);
+    if m > core::f32::consts::SQRT_2 {
+        m *= 0.5;
+        e += 1;
+    }
+    let e = e as f32;
+    e * LN2_HI + (ln1p_reduced(m - 1.0) + e * LN2_LO)
+}
+
+/// Table step of [`log_i0`] below [`LOG_I0_TABLE_MAX`]: `1 / 64`.
+const LOG_I0_STEPS_PER_UNIT: f32 = 64.0;
+/// End of [`log_i0`]'s table: `ln I0` is tabulated on `[0, 32]`.
+pub const LOG_I0_TABLE_MAX: f32 = 32.0;
+const LOG_I0_ENTRIES: usize = 32 * 64 + 1;
+
+/// `ln I0(k / 64)`, `k = 0..=2048`, rounded to f32 from an f64 evaluation at compile time
+/// (the power series of `I0`, `sum (x^2/4)^k / (k!)^2`, and [`ln_f64_const`]).
+static LOG_I0_TABLE: [f32; LOG_I0_ENTRIES] = log_i0_table();
+
+const fn log_i0_table() -> [f32; LOG_I0_ENTRIES] {
+    let mut t = [0.0f32; LOG_I0_ENTRIES];
+    let mut k = 0;
+    while k < LOG_I0_ENTRIES {
+        let x = k as f64 / 64.0;
+        let q = x * x / 4.0;
+        let (mut term, mut sum, mut j) = (1.0f64, 1.0f64, 1.0f64);
+        while term > sum * 1e-18 {
+            term *= q / (j * j);
+            sum += term;
+            j += 1.0;
+        }
+        t[k] = ln_f64_const(sum) as f32;
+        k += 1;
+    }
+    t
+}
+
+/// `ln(y)` for `y >= 1` in f64 at compile time: halve to `m` in `[1, sqrt 2]` (exact),
+/// then `2 atanh((m - 1) / (m + 1))` summed until the terms vanish.
+const fn ln_f64_const(mut y: f64) -> f64 {
+    let mut e = 0.0f64;
+    while y > core::f64::consts::SQRT_2 {
+        y /= 2.0;
+        e += 1.0;
+    }
+    let s = (y - 1.0) / (y + 1.0);
+    let s2 = s * s;
+    let (mut pow, mut sum, mut k) = (s, 0.0f64, 1.0f64);
+    while pow > 1e-20 || pow < -1e-20 {
+        sum += pow / k;
+        pow *= s2;
+        k += 2.0;
+    }
+    2.0 * sum + e * core::f64::consts::LN_2
 }
 
 /// `ln I0(x)` for `x >= 0` (modified Bessel function of the first kind, order 0), stable
 /// for every finite `x` (no overflow: `I0(x) ~ e^x / sqrt(2 pi x)`).
 ///
-/// Abramowitz & Stegun 9.8.1 (`x <= 3.75`, `ln1p` of the series) and 9.8.2 (`x > 3.75`,
-/// `x - ln(x)/2 + ln(poly(3.75/x))`); relative error of `I0` below `2e-7`, so the
-/// absolute error of the log is below `~3e-7` plus `f32` rounding of `x`. Negative `x`
-/// uses `I0(-x) = I0(x)`; NaN gives NaN.
+/// Below [`LOG_I0_TABLE_MAX`] (every cell but the strongest of a bright target): linear
+/// interpolation in a table of step `1/64` (8 KiB, built at compile time); the error of
+/// the chord is at most `max |(ln I0)''| h^2 / 8 = 0.5 / (8 * 64^2) = 1.53e-5`, always
+/// an overestimate (`ln I0` is convex), plus f32 rounding. Above it: Abramowitz & Stegun
+/// 9.8.2, `x + ln(poly(3.75/x) / sqrt(x))` (relative error of `I0` below `2e-7`). So the
+/// absolute error is below `1.6e-5 + 2e-7 ln I0(x)` (tested against an f64 reference).
+/// Negative `x` uses `I0(-x) = I0(x)`; NaN gives NaN.
 #[allow(clippy::excessive_precision)]
 pub fn log_i0(x: f32) -> f32 {
     let ax = if x < 0.0 { -x } else { x };
-    if ax <= 3.75 {
-        let t = (ax / 3.75) * (ax / 3.75);
-        let p = t
-            * (3.515_622_9
-                + t * (3.089_942_4
-                    + t * (1.206_749_2 + t * (0.265_973_2 + t * (0.036_076_8 + t * 0.004_581_3)))));
-        math::ln1p(p)
-    } else {
+    let u = ax * LOG_I0_STEPS_PER_UNIT;
+    if u < (LOG_I0_ENTRIES - 1) as f32 {
+        let k = u as usize;
+        let f = u - k as f32;
+        match (LOG_I0_TABLE.get(k), LOG_I0_TABLE.get(k + 1)) {
+            (Some(&a), Some(&b)) => a + f * (b - a),
+            _ => 0.0,
+        }
+    } else if ax < 1.0e30 {
         let t = 3.75 / ax;
         let p = 0.398_942_28
             + t * (0.013_285_92
@@ -479,7 +676,11 @@ pub fn log_i0(x: f32) -> f32 {
                         + t * (0.009_162_81
                             + t * (-0.020_577_06
                                 + t * (0.026_355_37 + t * (-0.016_476_33 + t * 0.003_923_77)))))));
-        ax - 0.5 * math::ln(ax) + math::ln(p)
+        ax + ln_fast(p / sqrt(ax))
+    } else {
+        // Far beyond any cell (and NaN): the two logs of the asymptotic form.
+        let t = 3.75 / ax;
+        ax - 0.5 * math::ln(ax) + math::ln(0.398_942_28 + t * 0.013_285_92)
     }
 }
 
@@ -488,7 +689,14 @@ pub fn log_i0(x: f32) -> f32 {
 /// `ln L(z | x) = -mu^2 / (2 sigma^2) + ln I0(mu sqrt(z) / sigma^2)` (eq. 21-23).
 #[inline]
 pub fn cell_log_lr(z: f32, mu: f32, sigma2: f32) -> f32 {
-    -mu * mu / (2.0 * sigma2) + log_i0(mu * math::sqrt(z) / sigma2)
+    let inv = 1.0 / sigma2;
+    cell_llr(z, mu, inv, 0.5 * inv)
+}
+
+/// [`cell_log_lr`] with `inv = 1 / sigma^2` and `half_inv = 1 / (2 sigma^2)` hoisted.
+#[inline(always)]
+fn cell_llr(z: f32, mu: f32, inv: f32, half_inv: f32) -> f32 {
+    log_i0(mu * sqrt(z) * inv) - mu * mu * half_inv
 }
 
 /// A validated, borrowed power cube.
@@ -510,16 +718,18 @@ impl<'a> PowerCube<'a> {
                 got: data.len(),
             });
         }
-        let mut bad_nan = false;
-        let mut bad_neg = false;
+        // One unsigned compare per cell: the bits of a finite `z >= 0` are below those of
+        // `+inf` (`-0.0`, bits `0x8000_0000`, is mapped to 0); the error is told apart
+        // only when there is one.
+        let mut top = 0u32;
         for &z in data {
-            bad_nan |= !z.is_finite();
-            bad_neg |= z < 0.0;
+            let b = z.to_bits();
+            top = top.max(if b == 0x8000_0000 { 0 } else { b });
         }
-        if bad_nan {
-            return Err(Error::NonFinite);
-        }
-        if bad_neg {
+        if top >= f32::INFINITY.to_bits() {
+            if data.iter().any(|z| !z.is_finite()) {
+                return Err(Error::NonFinite);
+            }
             return Err(Error::NegativeWeight);
         }
         Ok(Self { data, geometry })
@@ -547,18 +757,49 @@ impl<'a> PowerCube<'a> {
         amp: f32,
         sigma2: f32,
     ) -> (f32, usize) {
+        if psf.half_width.iter().all(|&w| w <= 1) {
+            self.log_lr_argmax_in::<3>(psf, c, amp, sigma2)
+        } else {
+            self.log_lr_argmax_in::<MAX_SPAN>(psf, c, amp, sigma2)
+        }
+    }
+
+    #[inline(always)]
+    fn log_lr_argmax_in<const S: usize>(
+        &self,
+        psf: &PointSpread,
+        c: &RadarCoords,
+        amp: f32,
+        sigma2: f32,
+    ) -> (f32, usize) {
+        let g = &self.geometry;
+        let (fr, fd, fb) = g.fractional(c);
+        let r = psf.axis_weights_in::<S>(0, fr, g.n_range);
+        let d = psf.axis_weights_in::<S>(1, fd, g.n_doppler);
+        let b = psf.axis_weights_in::<S>(2, fb, g.n_azimuth);
+        let inv = 1.0 / sigma2;
+        let half_inv = 0.5 * inv;
         let mut s = 0.0f32;
         let mut best = (usize::MAX, f32::NEG_INFINITY);
-        let data = self.data;
-        psf.for_each_cell(&self.geometry, c, |idx, h| {
-            if let Some(&z) = data.get(idx) {
-                let l = cell_log_lr(z, amp * h, sigma2);
-                s += l;
-                if l > best.1 {
-                    best = (idx, l);
+        // The loops of `PointSpread::for_each_cell_of` (same cells, order and products),
+        // written out so that the sums stay in registers.
+        let hb = b.weights();
+        for (ir, &hr) in (r.lo..).zip(r.weights()) {
+            for (jd, &hd) in (d.lo..).zip(d.weights()) {
+                let hab = hr * hd;
+                let base = (ir * g.n_doppler + jd) * g.n_azimuth + b.lo;
+                let Some(row) = self.data.get(base..base + hb.len()) else {
+                    continue;
+                };
+                for (k, (&z, &h)) in row.iter().zip(hb).enumerate() {
+                    let l = cell_llr(z, amp * (hab * h), inv, half_inv);
+                    s += l;
+                    if l > best.1 {
+                        best = (base + k, l);
+                    }
                 }
             }
-        });
+        }
         (s, best.0)
     }
 
@@ -566,14 +807,7 @@ impl<'a> PowerCube<'a> {
     /// (the log of the product in eq. 20 and 24).
     #[inline]
     pub fn log_lr(&self, psf: &PointSpread, c: &RadarCoords, amp: f32, sigma2: f32) -> f32 {
-        let mut s = 0.0f32;
-        let data = self.data;
-        psf.for_each_cell(&self.geometry, c, |idx, h| {
-            if let Some(&z) = data.get(idx) {
-                s += cell_log_lr(z, amp * h, sigma2);
-            }
-        });
-        s
+        self.log_lr_argmax(psf, c, amp, sigma2).0
     }
 }
 
@@ -609,18 +843,126 @@ mod tests {
 
     #[test]
     fn log_i0_matches_f64_reference() {
-        // Tolerance: A&S relative error 2e-7 plus f32 rounding of x - ln x/2 (relative
-        // 6e-8 of a value up to ~1e4).
+        // Tolerance: below 32 the table's chord error (at most 1.53e-5, `log_i0`'s doc)
+        // plus f32 rounding of entries up to ~28 (1e-6); above, the A&S relative error
+        // 2e-7 plus f32 rounding of x - ln x/2 (relative 6e-8 of a value up to ~1e4).
+        // The step 0.001 below 40 puts points between every pair of table entries.
         let mut x = 0.0f64;
+        let mut worst = 0.0f64;
         while x < 1.0e4 {
             let got = log_i0(x as f32) as f64;
             let want = log_i0_ref(x as f32 as f64);
-            let tol = 1e-6 + 2e-7 * want.abs();
+            let tol = if x < 32.0 { 1.7e-5 } else { 1e-6 } + 2e-7 * want.abs();
+            if x < 32.0 {
+                worst = worst.max(got - want);
+            }
             assert!((got - want).abs() <= tol, "x={x} got={got} want={want}");
-            x = if x < 10.0 { x + 0.01 } else { x * 1.01 };
+            x = if x < 40.0 { x + 0.001 } else { x * 1.01 };
         }
+        // The bound is nearly reached (the chord's error near 0 is 0.5 h^2 / 8).
+        assert!(worst > 1.0e-5, "{worst}");
         assert!(log_i0(1.0e30).is_finite());
         assert_eq!(log_i0(-2.0), log_i0(2.0));
+    }
+
+    /// `ln_fast` against `f64::ln` over the normal range (a geometric sweep, ratio
+    /// 1.0001, plus the neighbours of powers of two and of their `sqrt(2)` multiples,
+    /// where the reduction switches). Tolerance `4e-7 + 6e-8 |ln y|`: the series is exact
+    /// to `7e-10`; the rest is f32 rounding of the reduced log (a few ulps of a value
+    /// below 0.35) and of the final sum (half an ulp, `6e-8` relative).
+    #[test]
+    fn ln_fast_matches_f64() {
+        let mut checked = 0usize;
+        let mut check = |y: f32| {
+            let got = ln_fast(y) as f64;
+            let want = (y as f64).ln();
+            let err = (got - want).abs();
+            assert!(
+                err <= 4e-7 + 6e-8 * want.abs(),
+                "y={y:e} got={got} want={want}"
+            );
+            checked += 1;
+        };
+        let mut y = f32::MIN_POSITIVE;
+        while y < f32::MAX / 1.0001 {
+            check(y);
+            y *= 1.0001;
+        }
+        for e in -126..128 {
+            let p = 2.0f32.powi(e);
+            for v in [p, p * core::f32::consts::SQRT_2] {
+                for u in [-2i32, -1, 0, 1, 2] {
+                    let b = (v.to_bits() as i32 + u) as u32;
+                    let y = f32::from_bits(b);
+                    if y.is_finite() && y >= f32::MIN_POSITIVE {
+                        check(y);
+                    }
+                }
+            }
+        }
+        assert!(checked > 1_000_000, "{checked}");
+        assert_eq!(ln_fast(0.0), f32::NEG_INFINITY);
+        assert!(ln_fast(-1.0).is_nan());
+        assert_eq!(ln_fast(f32::INFINITY), f32::INFINITY);
+        assert_eq!(ln_fast(1.0), 0.0);
+    }
+
+    /// `exp_neg` against `f64::exp` on `[-87, 0]` (step 1e-4, plus the points where
+    /// the reduction's `n` changes). Tolerance `4e-7` relative: the polynomial's
+    /// truncation (1.3e-7) plus f32 rounding of the reduction and of Horner's steps.
+    #[test]
+    fn exp_neg_matches_f64() {
+        let check = |x: f32| {
+            let got = exp_neg(x) as f64;
+            let want = (x as f64).exp();
+            assert!(
+                (got - want).abs() <= 4e-7 * want,
+                "x={x} got={got} want={want}"
+            );
+        };
+        let mut k = 0u32;
+        while k <= 870_000 {
+            check(-(k as f32) * 1e-4);
+            k += 1;
+        }
+        for n in 0..126 {
+            let x = -(n as f32 + 0.5) * core::f32::consts::LN_2;
+            for u in [-1i32, 0, 1] {
+                check(f32::from_bits((x.to_bits() as i32 + u) as u32));
+            }
+        }
+        assert_eq!(exp_neg(0.0), 1.0);
+        assert_eq!(exp_neg(-100.0), 0.0);
+        assert_eq!(exp_neg(f32::NEG_INFINITY), 0.0);
+        assert_eq!(exp_neg(1.0), math::exp(1.0));
+        assert!(exp_neg(f32::NAN).is_nan());
+    }
+
+    /// `sin_cos` against `f64` on `[-200, 200]` (step 1e-3, plus the points where the
+    /// quadrant changes). Tolerance `3e-7` absolute: the polynomials' truncation (below
+    /// 3e-8) plus f32 rounding of the reduction and of Horner's steps (values up to 1,
+    /// a few ulps of 6e-8).
+    #[test]
+    fn sin_cos_matches_f64() {
+        let check = |x: f32| {
+            let (s, c) = sin_cos(x);
+            let (ws, wc) = (x as f64).sin_cos();
+            assert!((s as f64 - ws).abs() <= 3e-7, "sin x={x} got={s} want={ws}");
+            assert!((c as f64 - wc).abs() <= 3e-7, "cos x={x} got={c} want={wc}");
+        };
+        let mut k = -200_000i32;
+        while k <= 200_000 {
+            check(k as f32 * 1e-3);
+            k += 1;
+        }
+        for q in -127..=127 {
+            let x = (q as f32 + 0.5) * core::f32::consts::FRAC_PI_2;
+            for u in [-1i32, 0, 1] {
+                check(f32::from_bits((x.to_bits() as i32 + u) as u32));
+            }
+        }
+        assert_eq!(sin_cos(1.0e6), (math::sin(1.0e6), math::cos(1.0e6)));
+        assert!(sin_cos(f32::NAN).0.is_nan());
     }
 
     #[test]

@@ -11,6 +11,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
+use crate::math::KahanSum;
 use crate::rng::Rng;
 use crate::{Error, Result};
 
@@ -86,18 +87,20 @@ impl<const N: usize, const K: usize> KMeans<N, K> {
         if let Some(&p) = pts.get((rng.below(n as u32) as usize).min(n - 1)) {
             self.centres[0] = p;
         }
+        // Sums in f32 with compensation (an f64 add is a software routine on the M4).
         for c in 1..k {
-            let mut total = 0.0f64;
+            let mut total = KahanSum::new();
             for &p in pts {
-                total += self.nearest_d2(p, c) as f64;
+                total.add(self.nearest_d2(p, c));
             }
+            let total = total.value();
             let mut pick = n - 1;
             if total > 0.0 {
-                let target = rng.uniform() as f64 * total;
-                let mut acc = 0.0f64;
+                let target = rng.uniform() * total;
+                let mut acc = KahanSum::new();
                 for (i, &p) in pts.iter().enumerate() {
-                    acc += self.nearest_d2(p, c) as f64;
-                    if acc > target {
+                    acc.add(self.nearest_d2(p, c));
+                    if acc.value() > target {
                         pick = i;
                         break;
                     }
@@ -125,20 +128,25 @@ impl<const N: usize, const K: usize> KMeans<N, K> {
                     changed = true;
                 }
             }
-            let mut sums = [[0.0f64; 2]; K];
+            // The mean as the old centre plus the mean offset from it: f32 sums of small
+            // offsets (a cluster's spread, not its distance from the origin), so no f64.
+            let mut sums = [[0.0f32; 2]; K];
             self.counts = [0; K];
             for (&p, &a) in pts.iter().zip(self.assign.iter()) {
                 let c = a as usize;
-                if let (Some(s), Some(n)) = (sums.get_mut(c), self.counts.get_mut(c)) {
-                    s[0] += p[0] as f64;
-                    s[1] += p[1] as f64;
+                if let (Some(s), Some(n), Some(q)) =
+                    (sums.get_mut(c), self.counts.get_mut(c), self.centres.get(c))
+                {
+                    s[0] += p[0] - q[0];
+                    s[1] += p[1] - q[1];
                     *n += 1;
                 }
             }
             for c in 0..k {
                 if self.counts[c] > 0 {
-                    let m = self.counts[c] as f64;
-                    self.centres[c] = [(sums[c][0] / m) as f32, (sums[c][1] / m) as f32];
+                    let inv = 1.0 / self.counts[c] as f32;
+                    let q = self.centres[c];
+                    self.centres[c] = [q[0] + sums[c][0] * inv, q[1] + sums[c][1] * inv];
                 }
             }
             if !changed {

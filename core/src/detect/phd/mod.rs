@@ -22,7 +22,7 @@ pub use dbscan::{Dbscan, DbscanParams};
 pub use kmeans::KMeans;
 pub use pso::{PsoConfig, Swarm, MAX_GENERATIONS};
 pub use smc_phd::{
-    BirthComponent, BirthMode, BirthModel, Estimate, Extractor, PhdConfig, PhdReport, SmcPhdTbd,
-    SmcPhdTbdHost, SmcPhdTbdM4, SmcPhdTbdSmall, SmcPhdTbdSoak, MAX_BIRTH_COMPONENTS, MAX_INTENSITY,
-    MAX_MUTATION, MAX_REGION_CELLS,
+    BirthComponent, BirthMode, BirthModel, Estimate, Extractor, PhdConfig, PhdReport, PhdStage,
+    SmcPhdTbd, SmcPhdTbdHost, SmcPhdTbdM4, SmcPhdTbdM4Half, SmcPhdTbdSmall, SmcPhdTbdSoak,
+    MAX_BIRTH_COMPONENTS, MAX_INTENSITY, MAX_MUTATION, MAX_REGION_CELLS,
 };

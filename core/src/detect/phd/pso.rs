@@ -16,6 +16,7 @@
 
 use super::ndsort::{self, ens_bs};
 use crate::math;
+use crate::model::power_cube::exp_neg;
 use crate::rng::Rng;
 use crate::sort;
 
@@ -321,7 +322,7 @@ impl<const SWARM: usize, const POINTS: usize> Swarm<SWARM, POINTS> {
             let dy = p[1] - z[1];
             let a = (dx * dx + dy * dy) * inv_two_s2;
             // NaN (a non-finite position) is below the gate too: fitness is never NaN.
-            let v = if a <= cut { math::exp(-a) } else { 0.0 };
+            let v = if a <= cut { exp_neg(-a) } else { 0.0 };
             *f = v;
             total += v;
         }

@@ -3,6 +3,7 @@
 //! the next frame's birth cells.
 
 use super::*;
+use crate::model::power_cube;
 
 /// Maximum number of birth components.
 pub const MAX_BIRTH_COMPONENTS: usize = 4;
@@ -139,7 +140,7 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
                     let az = (g.azimuth_start_deg
                         + (lb as f32 + self.rng.uniform()) * g.azimuth_cell_deg)
                         / DEG_PER_RAD;
-                    let (sb, cb) = (math::sin(az), math::cos(az));
+                    let (sb, cb) = power_cube::sin_cos(az);
                     let mut vt = tang * self.rng.normal();
                     for _ in 0..np.min(4) {
                         let Some(&(pidx, _)) = prev.get(self.rng.below(np as u32) as usize) else {
@@ -206,7 +207,7 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
             let d = g.doppler_start + (jd as f32 + self.rng.uniform()) * g.doppler_cell;
             let az = (g.azimuth_start_deg + (lb as f32 + self.rng.uniform()) * g.azimuth_cell_deg)
                 / DEG_PER_RAD;
-            let (sb, cb) = (math::sin(az), math::cos(az));
+            let (sb, cb) = power_cube::sin_cos(az);
             let vt = tang * self.rng.normal();
             let (vx, vy) = (d * cb - vt * sb, d * sb + vt * cb);
             let inten = self.rng.uniform_range(b.intensity[0], b.intensity[1]);
@@ -241,19 +242,7 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
             self.cfg.psf.peak_radius(1),
             self.cfg.psf.peak_radius(2),
         ];
-        let psf = self.cfg.psf.central();
-        let wa = [psf.half(0), psf.half(1), psf.half(2)];
-        // Weights of a target at a cell centre, squared: `h^2 = exp(-L delta^2)`,
-        // `delta = k - w` cells (the interior cells of `PointSpread::axis_weights`).
-        let mut h2 = [[0.0f32; 2 * MAX_HALF_WIDTH + 1]; 3];
-        for (a, row) in h2.iter_mut().enumerate() {
-            let loss = psf.loss(a);
-            for (k, v) in row.iter_mut().enumerate().take(2 * wa[a] + 1) {
-                let dl = k as f32 - wa[a] as f32;
-                *v = math::exp(-loss * dl * dl);
-            }
-        }
-        let (w0, w1, w2) = (wa[0], wa[1], wa[2]);
+        let (h2, wa) = centre_weights(&self.cfg.psf);
         let data = cube.data();
         let out = self.birth_cells.as_flattened_mut();
         let want = want.min(out.len());
@@ -264,28 +253,7 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
         for ir in 0..g.n_range {
             for jd in 0..g.n_doppler {
                 for lb in 0..g.n_azimuth {
-                    let mut z = 0.0f32;
-                    for (a, &hr) in h2[0].iter().enumerate().take(2 * w0 + 1) {
-                        let Some(i) = (ir + a).checked_sub(w0).filter(|&i| i < g.n_range) else {
-                            continue;
-                        };
-                        for (c, &hd) in h2[1].iter().enumerate().take(2 * w1 + 1) {
-                            let Some(j) = (jd + c).checked_sub(w1).filter(|&j| j < g.n_doppler)
-                            else {
-                                continue;
-                            };
-                            let base = (i * g.n_doppler + j) * g.n_azimuth;
-                            for (e, &hb) in h2[2].iter().enumerate().take(2 * w2 + 1) {
-                                let Some(l) = (lb + e).checked_sub(w2).filter(|&l| l < g.n_azimuth)
-                                else {
-                                    continue;
-                                };
-                                if let Some(&v) = data.get(base + l) {
-                                    z += hr * hd * hb * v;
-                                }
-                            }
-                        }
-                    }
+                    let z = matched(data, &g, &h2, wa, ir, jd, lb);
                     if n == want && z <= min {
                         continue;
                     }
@@ -392,53 +360,34 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
             g.n_azimuth,
         );
         let data = cube.data();
+        let (h2, wa) = centre_weights(psf);
         let mut n = 0usize;
-        // The spread of a target at a cell centre, one axis at a time (each axis depends
-        // on one cell index only, so it is computed once per grid line, not per cell;
-        // bit-identical to `for_each_cell` at the centre). Azimuth weights are cached
-        // for windows up to `AZ_CACHE` cells wide.
-        const AZ_CACHE: usize = 16;
-        let frac = |ir: usize, jd: usize, lb: usize| {
-            g.fractional(&RadarCoords {
-                range: g.range_centre(ir),
-                doppler: g.doppler_centre(jd),
-                azimuth_deg: g.azimuth_centre(lb),
-            })
-        };
-        let mut az = [AxisWeights::NONE; AZ_CACHE];
-        let cached = b1.saturating_sub(b0) <= AZ_CACHE;
-        if cached {
-            for (w, lb) in az.iter_mut().zip(b0..b1) {
-                *w = psf.axis_weights(2, frac(0, 0, lb).2, g.n_azimuth);
-            }
-        }
+        // The weakest kept statistic and its slot once `out` is full.
+        let mut min = (f32::NEG_INFINITY, 0usize);
         for ir in r0..r1 {
-            let wr = psf.axis_weights(0, frac(ir, 0, 0).0, g.n_range);
             for jd in 0..g.n_doppler {
-                let wd = psf.axis_weights(1, frac(0, jd, 0).1, g.n_doppler);
                 for lb in b0..b1 {
                     let idx = g.index(ir, jd, lb);
                     // Point-spread-matched statistic `sum h^2 z` of a target at the cell
                     // centre, as for the swarm's points.
-                    let wb = match az.get(lb - b0) {
-                        Some(w) if cached => *w,
-                        _ => psf.axis_weights(2, frac(0, 0, lb).2, g.n_azimuth),
-                    };
-                    let mut z = 0.0f32;
-                    psf.for_each_cell_of(g, &wr, &wd, &wb, |i, h| {
-                        if let Some(&v) = data.get(i) {
-                            z += h * h * v;
-                        }
-                    });
+                    let z = matched(data, g, &h2, wa, ir, jd, lb);
                     if n < out.len() {
                         out[n] = (idx, z);
                         n += 1;
-                    } else if let Some(min) = out
-                        .iter_mut()
-                        .min_by(|a, b| a.1.partial_cmp(&b.1).unwrap_or(core::cmp::Ordering::Equal))
-                    {
-                        if z > min.1 {
-                            *min = (idx, z);
+                    } else if z > min.0 {
+                        if let Some(o) = out.get_mut(min.1) {
+                            *o = (idx, z);
+                        }
+                    } else {
+                        continue;
+                    }
+                    if n == out.len() {
+                        // The first of the smallest, as `min_by` picks it.
+                        min = (f32::INFINITY, 0);
+                        for (k, o) in out.iter().enumerate() {
+                            if o.1 < min.0 {
+                                min = (o.1, k);
+                            }
                         }
                     }
                 }
@@ -446,4 +395,59 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
         }
         n
     }
+}
+
+/// The squared weights `h^2 = exp(-L delta^2)` of a target at a cell centre on each
+/// axis (`delta = k - w` cells, `k = 0..=2w`) over the central `3 x 3 x 3` cells
+/// ([`PointSpread::central`]), and the half widths: the same for every cell, so computed
+/// once per frame.
+fn centre_weights(psf: &PointSpread) -> ([[f32; 3]; 3], [usize; 3]) {
+    let psf = psf.central();
+    let wa = [psf.half(0), psf.half(1), psf.half(2)];
+    let mut h2 = [[0.0f32; 3]; 3];
+    for (a, row) in h2.iter_mut().enumerate() {
+        let loss = psf.loss(a);
+        for (k, v) in row.iter_mut().enumerate().take(2 * wa[a] + 1) {
+            let dl = k as f32 - wa[a] as f32;
+            *v = math::exp(-loss * dl * dl);
+        }
+    }
+    (h2, wa)
+}
+
+/// The point-spread-matched statistic `sum h^2 z` of a target at the centre of cell
+/// `(ir, jd, lb)` over the in-cube cells of the central spread ([`centre_weights`]).
+#[inline(always)]
+fn matched(
+    data: &[f32],
+    g: &CubeGeometry,
+    h2: &[[f32; 3]; 3],
+    wa: [usize; 3],
+    ir: usize,
+    jd: usize,
+    lb: usize,
+) -> f32 {
+    // The cells `c - w ..= c + w` inside the axis, and the weight slot `k = i + w - c`
+    // of the first one.
+    let span = |c: usize, w: usize, n: usize| {
+        let lo = c.saturating_sub(w);
+        (lo, (c + w).min(n.saturating_sub(1)), lo + w - c)
+    };
+    let (i0, i1, ki) = span(ir, wa[0], g.n_range);
+    let (j0, j1, kj) = span(jd, wa[1], g.n_doppler);
+    let (l0, l1, kl) = span(lb, wa[2], g.n_azimuth);
+    let hb = h2[2].get(kl..).unwrap_or(&[]);
+    let mut z = 0.0f32;
+    for (i, &hr) in (i0..=i1).zip(h2[0].get(ki..).unwrap_or(&[])) {
+        for (j, &hd) in (j0..=j1).zip(h2[1].get(kj..).unwrap_or(&[])) {
+            let hrd = hr * hd;
+            let base = (i * g.n_doppler + j) * g.n_azimuth;
+            if let Some(row) = data.get(base + l0..=base + l1) {
+                for (&v, &h) in row.iter().zip(hb) {
+                    z += hrd * h * v;
+                }
+            }
+        }
+    }
+    z
 }

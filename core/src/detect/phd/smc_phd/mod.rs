@@ -35,9 +35,7 @@ use super::pso::{PsoConfig, Swarm};
 use crate::detect::interface::unconfigured_is_zero;
 use crate::detect::{Detection, Detector, ScoreKind, Validate};
 use crate::math::{self, KahanSum};
-use crate::model::power_cube::{
-    AxisWeights, CubeGeometry, PointSpread, PowerCube, RadarCoords, DEG_PER_RAD, MAX_HALF_WIDTH,
-};
+use crate::model::power_cube::{CubeGeometry, PointSpread, PowerCube, RadarCoords, DEG_PER_RAD};
 use crate::particles::{resample, Scheme};
 use crate::rng::Rng;
 use crate::{Error, Result};
@@ -249,9 +247,70 @@ pub struct PhdReport {
     pub extract_failed: bool,
 }
 
+/// The stages of one frame, in order, as [`SmcPhdTbd::step_probed`] reports their ends.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PhdStage {
+    /// The cube's checks (length, finite, non-negative).
+    Check,
+    /// The CV prediction of the survivors (eq. 14-15).
+    Predict,
+    /// The birth particles (eq. 16-17).
+    Births,
+    /// The swarm's measurement points `Z_m` and their refinement (PSO only).
+    Points,
+    /// The swarm (PSO only).
+    Swarm,
+    /// Every particle's log likelihood ratio over its covered cells (eq. 21-24).
+    Likelihood,
+    /// The grouping by cell and the normalisation of eq. 20, 25.
+    Normalise,
+    /// `N_hat` and the systematic resampling (eq. 26).
+    Resample,
+    /// The state extraction (K-means or DBSCAN).
+    Extract,
+    /// The next frame's birth cells.
+    BirthCells,
+}
+
+impl PhdStage {
+    /// Every stage, in frame order.
+    pub const ALL: [Self; 10] = [
+        Self::Check,
+        Self::Predict,
+        Self::Births,
+        Self::Points,
+        Self::Swarm,
+        Self::Likelihood,
+        Self::Normalise,
+        Self::Resample,
+        Self::Extract,
+        Self::BirthCells,
+    ];
+
+    /// Short name.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Check => "cube check",
+            Self::Predict => "prediction",
+            Self::Births => "births",
+            Self::Points => "swarm points",
+            Self::Swarm => "swarm",
+            Self::Likelihood => "likelihood",
+            Self::Normalise => "normalisation",
+            Self::Resample => "resampling",
+            Self::Extract => "extraction",
+            Self::BirthCells => "birth cells",
+        }
+    }
+}
+
 /// The firmware's filter (with its cube window it fits 1 MiB of RAM): 6144 particles,
 /// a 1024-entry swarm, 8 points, 8 targets.
 pub type SmcPhdTbdM4 = SmcPhdTbd<6144, 1024, 8, 8>;
+/// The firmware's filter within 512 KiB of static RAM with its 32^3-cell cube window
+/// (375 544 + 131 072 B on the Cortex-M4F): 2048 particles (three targets at 500 plus
+/// 500 births), the preset's 1024-entry swarm (512 particles move), 8 points, 8 targets.
+pub type SmcPhdTbdM4Half = SmcPhdTbd<2048, 1024, 8, 8>;
 /// The host's filter: 8192 particles, a 16384-entry swarm, 10 points, 16 targets.
 pub type SmcPhdTbdHost = SmcPhdTbd<8192, 16384, 10, 16>;
 /// The golden case's filter: 256 particles, a 256-entry swarm, 4 points, 4 targets.
@@ -410,18 +469,37 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
     /// point: the elitist selection keeps each group's particle count and the PHD mass
     /// is preserved per group.
     fn step_cube(&mut self, cube: &[f32]) -> Result<PhdReport> {
+        self.step_probed(cube, |_| {})
+    }
+
+    /// [`Detector::step`] calling `probe(stage)` as each stage of the frame ends (for
+    /// per-stage cost measurements, e.g. the firmware's stage rows; the results are
+    /// those of `step`).
+    pub fn step_probed(
+        &mut self,
+        cube: &[f32],
+        mut probe: impl FnMut(PhdStage),
+    ) -> Result<PhdReport> {
         let cube = PowerCube::new(cube, self.cfg.geometry)?;
+        probe(PhdStage::Check);
         let mut report = PhdReport::default();
         self.predict();
+        probe(PhdStage::Predict);
         let n_surv = self.n;
         self.add_births();
+        probe(PhdStage::Births);
         if let Some(pso) = self.cfg.pso {
             self.select_points(&cube, n_surv, pso.points);
+            probe(PhdStage::Points);
             let (sw, gens) = self.swarm_step(&pso);
+            probe(PhdStage::Swarm);
             report.swarm = sw;
             report.pso_generations = gens;
         }
-        let mass = self.update(&cube);
+        self.likelihood(&cube);
+        probe(PhdStage::Likelihood);
+        let mass = self.update();
+        probe(PhdStage::Normalise);
         report.mass = mass;
         let nh = if mass.is_finite() && mass > 0.0 {
             math::round(mass) as usize
@@ -436,12 +514,15 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
             report.n_hat = 0;
             self.n = 0;
         }
+        probe(PhdStage::Resample);
         report.particles = self.n;
         if self.extract(report.n_hat).is_err() {
             self.n_est = 0;
             report.extract_failed = true;
         }
+        probe(PhdStage::Extract);
         self.choose_birth_cells(&cube);
+        probe(PhdStage::BirthCells);
         report.estimates = self.n_est;
         Ok(report)
     }

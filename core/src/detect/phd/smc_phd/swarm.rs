@@ -3,6 +3,7 @@
 //! swarm move of the gated particles.
 
 use super::*;
+use crate::model::power_cube;
 
 impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARGETS: usize>
     SmcPhdTbd<PARTICLES, SWARM, POINTS, TARGETS>
@@ -183,7 +184,7 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
         let mut gated = 0usize;
         for (i, x) in self.x.iter().enumerate().take(self.n) {
             let (k, d) = nearest([x[0], x[2]], zpts);
-            if math::exp(-d * inv) >= pso.gate {
+            if power_cube::exp_neg(-d * inv) >= pso.gate {
                 // gated <= i
                 if let (Some(o), Some(kk)) = (self.order.get_mut(gated), self.key.get_mut(gated)) {
                     (*o, *kk) = (i as u32, k as u32);

@@ -3,6 +3,7 @@
 //! extraction (DBSCAN or K-means).
 
 use super::*;
+use crate::model::power_cube;
 
 /// The 13 "forward" neighbours of a cell (the other 13 are found from the other side).
 const NEIGHBOURS: [(i64, i64, i64); 13] = [
@@ -40,8 +41,9 @@ fn find(parent: &mut [u32], mut r: usize) -> usize {
 impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARGETS: usize>
     SmcPhdTbd<PARTICLES, SWARM, POINTS, TARGETS>
 {
-    /// Weight update of eq. 20/24-25; returns `sum w`.
-    pub(super) fn update(&mut self, cube: &PowerCube<'_>) -> f32 {
+    /// The log weights `ln w_i + ln L_i` and cells `c(i)` of eq. 20, 24-25 (in `lw`,
+    /// `key`).
+    pub(super) fn likelihood(&mut self, cube: &PowerCube<'_>) {
         let g = *cube.geometry();
         let psf = self.cfg.psf;
         let s2 = self.cfg.noise_var;
@@ -50,7 +52,11 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
             let s = self.x[i];
             let c = RadarCoords::from_state(s[0], s[1], s[2], s[3]);
             let (ll, cell) = if self.w[i] > 0.0 && g.cell_of(&c).is_some() {
-                cube.log_lr_argmax(&psf, &c, math::sqrt(s[4].max(0.0)), s2)
+                {
+                    // `max(0.0)` without the library call (NaN also gives 0).
+                    let inten = if s[4] > 0.0 { s[4] } else { 0.0 };
+                    cube.log_lr_argmax(&psf, &c, power_cube::sqrt(inten), s2)
+                }
             } else {
                 (0.0, usize::MAX)
             };
@@ -61,7 +67,7 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
             } else {
                 // Resolution cell of eq. 25: the covered cell with the largest factor.
                 self.key[i] = cell as u32;
-                let l = math::ln(self.w[i]) + ll;
+                let l = power_cube::ln_fast(self.w[i]) + ll;
                 self.lw[i] = if l.is_nan() || l == f32::INFINITY {
                     f32::NEG_INFINITY
                 } else {
@@ -70,6 +76,13 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
             }
             self.order[i] = i as u32;
         }
+    }
+
+    /// Weight update of eq. 20/24-25 from [`Self::likelihood`]'s log weights; returns
+    /// `sum w`.
+    pub(super) fn update(&mut self) -> f32 {
+        let g = self.cfg.geometry;
+        let n = self.n.min(PARTICLES);
         {
             let key = &self.key;
             crate::sort::sort_unstable_by_key(&mut self.order[..n], |&i| {
@@ -149,7 +162,7 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
         for i in 0..n {
             if let Some(p) = self.pts.get_mut(self.anc[i] as usize) {
                 if p[0] > f32::NEG_INFINITY {
-                    p[1] += math::exp(self.lw[i] - p[0]);
+                    p[1] += power_cube::exp_neg(self.lw[i] - p[0]);
                 }
             }
         }
@@ -164,7 +177,7 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
             let r = self.anc[i];
             let wi = match self.pts.get(r as usize) {
                 Some(p) if r != u32::MAX && self.lw[i] != f32::NEG_INFINITY => {
-                    math::exp(self.lw[i] - p[1])
+                    power_cube::exp_neg(self.lw[i] - p[1])
                 }
                 _ => 0.0,
             };
