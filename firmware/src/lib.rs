@@ -4,7 +4,8 @@
 //! (Cortex-M4F) and count what it costs: the board's counters ([`timer`]), the
 //! measurement harness and its Markdown table ([`harness`]), `static` storage for the
 //! large states ([`statics`]), a fixed-capacity string ([`text`]), the run's exits and
-//! command line through semihosting ([`semihosting`]), and the soak loop ([`soak`]).
+//! command line through semihosting ([`semihosting`]), the soak loop ([`soak`]), and the
+//! per-board counter of the `fit` images ([`board`]).
 //!
 //! The binaries (the layout of idsp's embedded tests):
 //! - `src/main.rs`, the instruction table (one module per detector family under
@@ -12,6 +13,8 @@
 //! - `src/bin/cycles.rs`, the regions of the cycle model (`tools/cycles`);
 //! - `src/bin/golden.rs`, the golden lines alone (the Cortex-M3, M33 and M7 boards);
 //! - `src/bin/soak.rs`, every detector streamed frames without a reset;
+//! - `src/bin/fit.rs`, one detector configuration built for one part's memory map
+//!   (`boards/`, [`board`]);
 //! - `src/bin/panic_never*.rs`, link-time proofs that no panic path survives.
 //!
 //! Each binary picks its panic handler: [`report_panics!`] (print, exit status 1) for
@@ -20,6 +23,7 @@
 //! different ones.
 #![no_std]
 
+pub mod board;
 pub mod harness;
 pub mod semihosting;
 pub mod soak;

@@ -70,7 +70,7 @@ use crate::detect::{Detection, Detector, ScoreKind, Validate};
 use crate::existence::{BirthGaps, ExistenceDraw};
 use crate::math::{self, KahanSum};
 use crate::model::doppler::{
-    check_frame, finite_estimate, DopplerModel, DopplerReport, Model, ModelConfig, Motion, Phase,
+    check_frame, finite_estimate, DopplerReport, Model, ModelConfig, Motion, Phase,
     ProjectionCache, DOPPLER_STATE, MAX_BINS,
 };
 use crate::particles::{gather_flagged, resample, systematic_with_sum, FlaggedState, Scheme};
@@ -137,12 +137,20 @@ impl CrpfConfig {
 
     /// Checks every value and builds the model.
     pub(crate) fn build(&self) -> Result<Model> {
-        self.build_reusing(None)
+        self.check()?;
+        self.model.build()
     }
 
-    /// [`CrpfConfig::build`], reusing `old`'s response table when it fits
-    /// ([`ModelConfig::build_reusing`](crate::model::doppler::ModelConfig::build_reusing)).
-    pub(crate) fn build_reusing(&self, old: Option<&DopplerModel>) -> Result<Model> {
+    /// Checks every value and writes the model into `model` in place
+    /// ([`ModelConfig::build_into`](crate::model::doppler::ModelConfig::build_into)); on
+    /// error `model` is unchanged.
+    pub(crate) fn build_into(&self, model: &mut Model) -> Result<()> {
+        self.check()?;
+        self.model.build_into(model)
+    }
+
+    /// Every error of [`CrpfConfig::build`], without building the response table.
+    fn check(&self) -> Result<()> {
         if !(self.p.is_finite() && self.p > 0.0) {
             return Err(Error::InvalidConfig("cost exponent p"));
         }
@@ -160,12 +168,12 @@ impl CrpfConfig {
         if !(0.0..=1.0).contains(&self.r_th) {
             return Err(Error::InvalidConfig("correlation threshold r_th"));
         }
-        let model = self.model.build_reusing(old)?;
+        let motion = self.model.check()?.motion;
         // At most one band width, one alias-free Doppler rate and the largest amplitude.
-        let w = model.motion.band_width();
+        let w = motion.band_width();
         let limits = [
             w,
-            w / model.motion.dt,
+            w / motion.dt,
             crate::model::doppler::max_amplitude(self.model.bins),
         ];
         if self
@@ -178,13 +186,13 @@ impl CrpfConfig {
                 "jitter std (at most W, W / dT, 1e18 / m)",
             ));
         }
-        Ok(model)
+        Ok(())
     }
 }
 
 impl Validate for CrpfConfig {
     fn validate(&self) -> Result<()> {
-        self.build().map(|_| ())
+        self.check()
     }
 }
 
@@ -1003,11 +1011,12 @@ impl<const PARTICLES: usize> Detector for CrpfTbd<PARTICLES> {
         if u32::try_from(PARTICLES).is_err() {
             return Err(Error::IndexOutOfRange);
         }
-        let model = cfg.build_reusing(Some(&self.model.obs))?;
+        // Checked, then written in place (the model's table is some 14 KB: no copy of it
+        // goes through the stack).
+        cfg.build_into(&mut self.model)?;
         self.int_exponent = int_exponent(cfg);
-        self.births = BirthGaps::new(&model.chain);
+        self.births = BirthGaps::new(&self.model.chain);
         self.cfg = *cfg;
-        self.model = model;
         self.init_from(seed);
         Ok(())
     }

@@ -19,7 +19,7 @@
 use crate::detect::Validate;
 use crate::math;
 use crate::model::doppler::{
-    check_frame, DopplerModel, DopplerReport, Likelihood, Model, ModelConfig, Motion, Phase,
+    check_frame, CheckedModel, DopplerReport, Likelihood, Model, ModelConfig, Motion, Phase,
     Whitener, Window,
 };
 use crate::particles::{gather_in_place, resample, Scheme};
@@ -159,35 +159,28 @@ impl GaussConfig {
 
     /// Checks the variance and builds the model.
     pub(crate) fn build(&self) -> Result<Model> {
-        self.build_reusing(None)
-    }
-
-    /// [`GaussConfig::build`], reusing `old`'s response table when it fits
-    /// ([`ModelConfig::build_reusing`](crate::model::doppler::ModelConfig::build_reusing)).
-    fn build_reusing(&self, old: Option<&DopplerModel>) -> Result<Model> {
         check_variance(self.noise_var)?;
-        self.weighing_model().build_reusing(old)
+        self.weighing_model().build()
     }
 
-    /// What every Gaussian comparator's `new` / `configure` needs: `N > 0`, a valid birth
-    /// proposal for `N`, the built weighing model (reusing `old`'s table when it fits) and
-    /// the weighing `1 / s2`.
-    pub(crate) fn prepare<const N: usize>(
-        &self,
-        old: Option<&DopplerModel>,
-    ) -> Result<(Model, f32)> {
+    /// What every Gaussian comparator's `new` / `configure` checks: `N > 0`, a valid
+    /// birth proposal for `N`, the weighing model's values (its table is not built) and
+    /// the weighing `1 / s2`. Returns the checked model and `1 / s2`.
+    pub(crate) fn prepare<const N: usize>(&self) -> Result<(CheckedModel, f32)> {
         if N == 0 {
             return Err(Error::InvalidConfig("particle count N = 0"));
         }
         self.birth.birth_count::<N>()?;
-        let model = self.build_reusing(old)?;
+        check_variance(self.noise_var)?;
+        let model = self.weighing_model().check()?;
         Ok((model, self.weighing_inv_var(self.noise_var)?))
     }
 }
 
 impl Validate for GaussConfig {
     fn validate(&self) -> Result<()> {
-        self.build()?;
+        check_variance(self.noise_var)?;
+        self.weighing_model().check()?;
         self.weighing_inv_var(self.noise_var)?;
         Whitener::check(self.likelihood, self.model.window, self.model.bins)
     }
@@ -313,7 +306,8 @@ struct Weigh<'a, P, const N: usize> {
 impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
     /// Validates `cfg`; particles are default until [`reset`](Self::reset).
     pub(crate) fn new(cfg: GaussConfig) -> Result<Self> {
-        let (model, inv_var) = cfg.prepare::<N>(None)?;
+        let (_, inv_var) = cfg.prepare::<N>()?;
+        let model = cfg.build()?;
         let mut white = Whitener::inactive();
         white.configure(cfg.likelihood, cfg.model.window, cfg.model.bins)?;
         Ok(Self {
@@ -334,12 +328,14 @@ impl<P: CloudParticle, const N: usize> GaussianCloud<P, N> {
     /// Re-validates `cfg` and installs it; on error `self` is unchanged. The caller
     /// [`reset`](Self::reset)s next.
     pub(crate) fn reconfigure(&mut self, cfg: GaussConfig) -> Result<()> {
-        let (model, inv_var) = cfg.prepare::<N>(Some(&self.model.obs))?;
+        let (model, inv_var) = cfg.prepare::<N>()?;
         // Validates before it writes: on error nothing has changed.
         self.white
             .configure(cfg.likelihood, cfg.model.window, cfg.model.bins)?;
         self.cfg = cfg;
-        self.model = model;
+        // In place: the model's table (some 14 KB) is not built on the stack, and is kept
+        // when it is already the one for these bins, sample interval and window.
+        model.write_into(&mut self.model);
         self.inv_var = inv_var;
         Ok(())
     }

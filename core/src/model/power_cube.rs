@@ -580,7 +580,7 @@ fn ln1p_reduced(f: f32) -> f32 {
 }
 
 /// `ln(y)` for `y > 0` with a few instructions: `y = 2^e m`, `m` in
-/// `[sqrt(1/2), sqrt(2))`, `ln y = e ln 2 + ln m` ([`ln1p_reduced`]). Absolute error
+/// `[sqrt(1/2), sqrt(2))`, `ln y = e ln 2 + ln m` (`ln(1 + f)` by the series in `s = f / (2 + f)` above). Absolute error
 /// below `4e-7` for `y` in `[2^-126, 2^128)` (f32 rounding; checked against `f64::ln`);
 /// subnormal, zero, infinite and NaN arguments go to `math::ln`.
 #[inline]

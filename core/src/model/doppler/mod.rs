@@ -187,19 +187,36 @@ impl ModelConfig {
     /// the same bins, sample interval and window ([`DopplerModel::new_reusing`]; same
     /// result, without the table's cost).
     pub fn build_reusing(&self, old: Option<&DopplerModel>) -> Result<Model> {
-        self.prior.validate()?;
-        if !(0.0..=1.0).contains(&self.initial_existence) {
-            return Err(Error::InvalidConfig("initial existence probability"));
-        }
+        let checked = self.check()?;
         let obs = match old {
             Some(old) => DopplerModel::new_reusing(self.bins, self.ts, self.window, old)?,
             None => DopplerModel::new(self.bins, self.ts, self.window)?,
         };
+        Ok(checked.with_table(obs))
+    }
+
+    /// [`ModelConfig::build`] in place: `model` takes this configuration, its response
+    /// table rebuilt in place ([`DopplerModel::build_into`]) unless it already holds the
+    /// one for these bins, sample interval and window; no model is built on the stack.
+    /// On error `model` is unchanged.
+    pub fn build_into(&self, model: &mut Model) -> Result<()> {
+        self.check()?.write_into(model);
+        Ok(())
+    }
+
+    /// Every error of [`ModelConfig::build`], without building the response table;
+    /// returns the model's other parts.
+    pub(crate) fn check(&self) -> Result<CheckedModel> {
+        self.prior.validate()?;
+        if !(0.0..=1.0).contains(&self.initial_existence) {
+            return Err(Error::InvalidConfig("initial existence probability"));
+        }
+        DopplerModel::check(self.bins, self.ts)?;
         let motion = Motion {
-            dt: obs.frame_time(),
+            dt: response::frame_time(self.bins, self.ts),
             accel_std: self.accel_std,
             amp_std: self.amp_std,
-            band: obs.band(),
+            band: response::band(self.ts),
         };
         motion.validate()?;
         let (lo, hi) = motion.band;
@@ -229,14 +246,50 @@ impl ModelConfig {
             ));
         }
         let chain = crate::existence::ExistenceMarkov::new(self.birth, self.death)?;
-        Ok(Model {
-            obs,
+        Ok(CheckedModel {
+            cfg: *self,
             motion,
             chain,
-            prior: self.prior,
-            initial_existence: self.initial_existence,
-            phase: self.phase,
         })
+    }
+}
+
+/// A validated [`ModelConfig`]: every part of its [`Model`] but the response table
+/// (small; the table is built by value or in place).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CheckedModel {
+    cfg: ModelConfig,
+    /// The motion model (its frame time and band are the table's).
+    pub(crate) motion: Motion,
+    chain: crate::existence::ExistenceMarkov,
+}
+
+impl CheckedModel {
+    /// The model with `obs`, the table built for the configuration's bins, sample
+    /// interval and window.
+    fn with_table(self, obs: DopplerModel) -> Model {
+        Model {
+            obs,
+            motion: self.motion,
+            chain: self.chain,
+            prior: self.cfg.prior,
+            initial_existence: self.cfg.initial_existence,
+            phase: self.cfg.phase,
+        }
+    }
+
+    /// Writes the model into `model` in place (cannot fail: the configuration is
+    /// checked); the table is rebuilt only if `model` holds another one.
+    pub(crate) fn write_into(self, model: &mut Model) {
+        let c = &self.cfg;
+        if !model.obs.is_built_for(c.bins, c.ts, c.window) {
+            model.obs.fill(c.bins, c.ts, c.window);
+        }
+        model.motion = self.motion;
+        model.chain = self.chain;
+        model.prior = c.prior;
+        model.initial_existence = c.initial_existence;
+        model.phase = c.phase;
     }
 }
 

@@ -201,38 +201,96 @@ pub struct DopplerModel {
 }
 
 impl DopplerModel {
-    /// Builds the table for `m` bins (`SPAN <= m <= MAX_BINS`) and sample interval `ts`.
+    /// A model of no bins (every projection is zero): the value a `static` starts from
+    /// before [`build_into`](Self::build_into) sets it up in place (all zero bits, so the
+    /// `static` lands in `.bss`).
+    pub const fn new_empty() -> Self {
+        Self {
+            m: 0,
+            m_f32: 0.0,
+            ts: 0.0,
+            window: Window::Rectangular,
+            rows: [[[0.0; 4]; SPAN]; TABLE_STEPS],
+            u_scale: 0.0,
+            u_off: 0.0,
+            first_of: [0; 2 * MAX_BINS],
+            hq: [[0.0; 3]; TABLE_STEPS],
+            window_sum: 0.0,
+            window_energy: 0.0,
+        }
+    }
+
+    /// Builds the table for `m` bins (`SPAN <= m <= MAX_BINS`) and sample interval `ts`
+    /// (by value: [`build_into`](Self::build_into) builds it in place).
     pub fn new(m: usize, ts: f32, window: Window) -> Result<Self> {
+        let mut s = Self::new_empty();
+        s.build_into(m, ts, window)?;
+        Ok(s)
+    }
+
+    /// [`DopplerModel::new`] in place: the table is written into `self`, with no
+    /// temporary model (about 14 KB) on the stack, only the window's `m` coefficients.
+    /// On error (the errors of [`new`](Self::new)) `self` is unchanged.
+    pub fn build_into(&mut self, m: usize, ts: f32, window: Window) -> Result<()> {
         Self::check(m, ts)?;
+        self.fill(m, ts, window);
+        Ok(())
+    }
+
+    /// Whether `self` holds the table of `m` bins, `ts` (same bits) and `window`: the
+    /// table depends on nothing else.
+    pub(super) fn is_built_for(&self, m: usize, ts: f32, window: Window) -> bool {
+        self.m == m && self.ts.to_bits() == ts.to_bits() && self.window == window
+    }
+
+    /// Writes the table of `m`, `ts`, `window` into `self` (checked by the caller with
+    /// [`check`](Self::check)).
+    ///
+    /// The table holds `W(u/m)`, `u = -(J + 1/2) + t / S` (`S` = [`TABLE_STEPS`]), for
+    /// `t = 0..=SPAN S`; cell `(i0, j)` of `rows` is `[a, b - a]` with `a` point
+    /// `t = i0 + (SPAN - 1 - j) S` and `b` point `t + 1`. Each point `t < SPAN S` is the `a`
+    /// of exactly one cell, so the points are written into the cells' `a` first, then
+    /// each cell's `b` is read from the cell holding point `t + 1` (the next row, or row 0
+    /// of the bin before, or the last point `t = SPAN S`): the same bits as a separate
+    /// table of `TABLE_LEN` points.
+    pub(super) fn fill(&mut self, m: usize, ts: f32, window: Window) {
         // The window's coefficients once, not once per table point (same bits).
         let mut w = [0.0f64; MAX_BINS];
         for (n, c) in w.iter_mut().enumerate().take(m) {
             *c = window.coefficient(n, m);
         }
         let w = w.get(..m).unwrap_or(&[]);
-        let mut table = [Complex32::new(0.0, 0.0); TABLE_LEN];
-        for (t, slot) in table.iter_mut().enumerate() {
+        let point = |t: usize| -> [f32; 2] {
             let u = -(HALF_SPAN as f64 + 0.5) + t as f64 / TABLE_STEPS as f64;
             let (re, im) = dtft_of(w.iter().copied(), u / m as f64);
-            *slot = Complex32::new(re as f32, im as f32);
-        }
-        let mut rows = [[[0.0f32; 4]; SPAN]; TABLE_STEPS];
-        for (i0, row) in rows.iter_mut().enumerate() {
+            [re as f32, im as f32]
+        };
+        for (i0, row) in self.rows.iter_mut().enumerate() {
             for (j, cell) in row.iter_mut().enumerate() {
-                let t = i0 + (SPAN - 1 - j) * TABLE_STEPS;
-                let (a, b) = match (table.get(t), table.get(t + 1)) {
-                    (Some(&a), Some(&b)) => (a, b),
-                    _ => (Complex32::new(0.0, 0.0), Complex32::new(0.0, 0.0)),
-                };
-                *cell = [a.re, a.im, b.re - a.re, b.im - a.im];
+                let [re, im] = point(i0 + (SPAN - 1 - j) * TABLE_STEPS);
+                *cell = [re, im, 0.0, 0.0];
             }
         }
-        let mut first_of = [0u16; 2 * MAX_BINS];
-        for (q, f) in first_of.iter_mut().enumerate() {
+        let last = point(TABLE_LEN - 1);
+        for i0 in 0..TABLE_STEPS {
+            for j in 0..SPAN {
+                let next = if i0 + 1 < TABLE_STEPS {
+                    self.rows.get(i0 + 1).and_then(|r| r.get(j))
+                } else {
+                    j.checked_sub(1)
+                        .and_then(|jb| self.rows.first().and_then(|r| r.get(jb)))
+                };
+                let b = next.map_or(last, |c| [c[0], c[1]]);
+                if let Some(cell) = self.rows.get_mut(i0).and_then(|r| r.get_mut(j)) {
+                    cell[2] = b[0] - cell[0];
+                    cell[3] = b[1] - cell[1];
+                }
+            }
+        }
+        for (q, f) in self.first_of.iter_mut().enumerate() {
             *f = (q as i64 - m as i64 - HALF_SPAN as i64).rem_euclid(m as i64) as u16;
         }
-        let mut hq = [[0.0f32; 3]; TABLE_STEPS];
-        for (h, row) in hq.iter_mut().zip(rows.iter()) {
+        for (h, row) in self.hq.iter_mut().zip(self.rows.iter()) {
             let (mut h0, mut h1, mut h2) = (0.0f64, 0.0f64, 0.0f64);
             for c in row.iter() {
                 let (ar, ai, dr, di) = (c[0] as f64, c[1] as f64, c[2] as f64, c[3] as f64);
@@ -249,19 +307,14 @@ impl DopplerModel {
             s += w;
             s2 += w * w;
         }
-        Ok(Self {
-            m,
-            m_f32: m as f32,
-            ts,
-            window,
-            rows,
-            u_scale: (ts as f64 * m as f64 * TABLE_STEPS as f64) as f32,
-            u_off: (TABLE_STEPS / 2 + TABLE_STEPS * m) as f32,
-            first_of,
-            hq,
-            window_sum: s as f32,
-            window_energy: s2 as f32,
-        })
+        self.m = m;
+        self.m_f32 = m as f32;
+        self.ts = ts;
+        self.window = window;
+        self.u_scale = (ts as f64 * m as f64 * TABLE_STEPS as f64) as f32;
+        self.u_off = (TABLE_STEPS / 2 + TABLE_STEPS * m) as f32;
+        self.window_sum = s as f32;
+        self.window_energy = s2 as f32;
     }
 
     /// Bins per frame `m`.
@@ -275,7 +328,7 @@ impl DopplerModel {
     }
 
     /// The errors of [`DopplerModel::new`] for `m` bins and sample interval `ts`.
-    fn check(m: usize, ts: f32) -> Result<()> {
+    pub(super) fn check(m: usize, ts: f32) -> Result<()> {
         if !(SPAN..=MAX_BINS).contains(&m) {
             return Err(Error::InvalidConfig("bins per frame (5..=512)"));
         }
@@ -291,7 +344,7 @@ impl DopplerModel {
     /// format skips them).
     pub fn new_reusing(m: usize, ts: f32, window: Window, old: &DopplerModel) -> Result<Self> {
         Self::check(m, ts)?;
-        if old.m == m && old.ts.to_bits() == ts.to_bits() && old.window == window {
+        if old.is_built_for(m, ts, window) {
             Ok(old.clone())
         } else {
             Self::new(m, ts, window)
@@ -300,7 +353,7 @@ impl DopplerModel {
 
     /// Frame time `dT = m ts` (s).
     pub fn frame_time(&self) -> f32 {
-        self.m as f32 * self.ts
+        frame_time(self.m, self.ts)
     }
 
     /// The window.
@@ -321,8 +374,7 @@ impl DopplerModel {
 
     /// Unambiguous Doppler band `[-1/(2 ts), 1/(2 ts))` (Hz).
     pub fn band(&self) -> (f32, f32) {
-        let h = 0.5 / self.ts;
-        (-h, h)
+        band(self.ts)
     }
 
     /// Nearest bin `b0` and interpolation position: the first of the [`SPAN`] bins is
@@ -474,6 +526,17 @@ fn kernel<const IM: bool>(row: &Row, zs: &[Complex32; SPAN], frac: f32) -> (f32,
         hh += hr * hr + hi * hi;
     }
     (zr, zi, hh)
+}
+
+/// Frame time `dT = m ts` (s) of `m` bins at sample interval `ts`.
+pub(super) fn frame_time(m: usize, ts: f32) -> f32 {
+    m as f32 * ts
+}
+
+/// Unambiguous Doppler band `[-1/(2 ts), 1/(2 ts))` (Hz).
+pub(super) fn band(ts: f32) -> (f32, f32) {
+    let h = 0.5 / ts;
+    (-h, h)
 }
 
 /// `W(theta) = sum_n w_n exp(j 2 pi theta n)` in `f64`.
@@ -660,5 +723,75 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The table as it was built before [`DopplerModel::build_into`]: a separate array of
+    /// the `TABLE_LEN` points, then each row's cells `[a, b - a]` read from it.
+    fn reference_rows(window: Window, m: usize) -> [Row; TABLE_STEPS] {
+        let mut table = [[0.0f32; 2]; TABLE_LEN];
+        for (t, slot) in table.iter_mut().enumerate() {
+            let u = -(HALF_SPAN as f64 + 0.5) + t as f64 / TABLE_STEPS as f64;
+            let (re, im) = dtft(window, m, u / m as f64);
+            *slot = [re as f32, im as f32];
+        }
+        core::array::from_fn(|i0| {
+            core::array::from_fn(|j| {
+                let t = i0 + (SPAN - 1 - j) * TABLE_STEPS;
+                let (a, b) = (table[t], table[t + 1]);
+                [a[0], a[1], b[0] - a[0], b[1] - a[1]]
+            })
+        })
+    }
+
+    /// Every field of the model, as bits.
+    fn bits(d: &DopplerModel) -> ([u32; 8], [[u32; 4]; 640], [u16; 2 * MAX_BINS], [u32; 384]) {
+        let rows: [[u32; 4]; 640] =
+            core::array::from_fn(|k| d.rows[k / SPAN][k % SPAN].map(f32::to_bits));
+        let hq: [u32; 384] = core::array::from_fn(|k| d.hq[k / 3][k % 3].to_bits());
+        let scalars = [
+            d.m as u32,
+            d.m_f32.to_bits(),
+            d.ts.to_bits(),
+            d.window as u32,
+            d.u_scale.to_bits(),
+            d.u_off.to_bits(),
+            d.window_sum.to_bits(),
+            d.window_energy.to_bits(),
+        ];
+        (scalars, rows, d.first_of, hq)
+    }
+
+    /// The table written in place (each cell's second point read from the cell that holds
+    /// it) has the bits of the separate table it replaced, slopes included, for every
+    /// window and for frame lengths at both ends and around the preset's; and building in
+    /// place over a model of another frame format gives the bits of a new model, while a
+    /// bad frame format leaves the model unchanged.
+    #[test]
+    fn table_built_in_place_has_the_bits_of_a_separate_table() {
+        for window in [Window::Rectangular, Window::Hamming, Window::Hann] {
+            for m in [SPAN, 6, 31, 32, 33, 100, MAX_BINS] {
+                let d = DopplerModel::new(m, 0.02, window).expect("valid model");
+                let want = reference_rows(window, m);
+                for (i0, (row, want)) in d.rows.iter().zip(want.iter()).enumerate() {
+                    for (j, (c, w)) in row.iter().zip(want.iter()).enumerate() {
+                        assert_eq!(
+                            c.map(f32::to_bits),
+                            w.map(f32::to_bits),
+                            "{window:?} m {m} ({i0}, {j})"
+                        );
+                    }
+                }
+                let mut other = DopplerModel::new(7, 0.5, Window::Hann).expect("valid model");
+                other.build_into(m, 0.02, window).expect("valid model");
+                assert_eq!(bits(&other), bits(&d), "{window:?}, m = {m}");
+                assert!(other.build_into(4, 0.02, window).is_err());
+                assert!(other.build_into(m, f32::NAN, window).is_err());
+                assert_eq!(bits(&other), bits(&d), "unchanged after an error");
+            }
+        }
+        let empty = DopplerModel::new_empty();
+        assert_eq!(empty.bins(), 0);
+        let z = [Complex32::new(1.0, 1.0); 32];
+        assert_eq!(empty.project(&z, 3.0, 1.0), Projection::default());
     }
 }

@@ -148,6 +148,15 @@ impl Whitener {
             self.m = 0;
             return Ok(());
         }
+        self.build_kernel(window, m);
+        Ok(())
+    }
+
+    /// The kernel of an active whitener (checked by the caller). Not inlined: its 4 KiB
+    /// of window coefficients are on the stack only while it runs, not in the frame of
+    /// every `configure` that may call it.
+    #[inline(never)]
+    fn build_kernel(&mut self, window: Window, m: usize) {
         let mut inv_w = [0.0f64; MAX_BINS];
         for (n, iw) in inv_w.iter_mut().enumerate().take(m) {
             *iw = 1.0 / window.coefficient(n, m);
@@ -163,7 +172,6 @@ impl Whitener {
             *c = Complex32::new((re / m as f64) as f32, (im / m as f64) as f32);
         }
         self.m = m;
-        Ok(())
     }
 
     /// The errors of [`configure`](Self::configure), without building the kernel (or
