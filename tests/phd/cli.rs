@@ -108,6 +108,18 @@ fn counts_and_snrs_are_checked_quick_or_not() {
             &["--quick", "--birth-pair-speed=-1"][..],
             "--birth-pair-speed",
         ),
+        (
+            &["--quick", "--filter-intensity-db", "-70"][..],
+            "--filter-intensity-db must lie in [-60, 60] dB, got -70",
+        ),
+        (
+            &["--filter-intensity-db", "inf"][..],
+            "--filter-intensity-db",
+        ),
+        (
+            &["--quick", "--cubes", "physics", "--runs", "0"][..],
+            "--runs must lie in 1..=1000000, got 0",
+        ),
     ] {
         let mut all = vec!["--out", out];
         all.extend_from_slice(args);
@@ -179,5 +191,58 @@ fn variants_select_the_algorithms_and_the_ablation_runs() {
     }
     let frames = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
     assert_eq!(frames.lines().count(), 1 + 2 * 40);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `--cubes` takes `model` or `physics`; anything else is refused before any run, the
+/// first line naming the value and `--cubes` (clap's error, like every value list).
+#[test]
+fn bad_cubes_are_refused() {
+    let dir = std::env::temp_dir().join(format!("faint-phd-cubes-{}", std::process::id()));
+    for (bad, needle) in [
+        ("sinc", "invalid value 'sinc' for '--cubes"),
+        ("Physics", "invalid value 'Physics' for '--cubes"),
+        ("", "a value is required for '--cubes"),
+    ] {
+        let (code, err) = phd(&["--quick", "--cubes", bad, "--out", dir.to_str().unwrap()]);
+        assert_ne!(code, 0, "{bad:?}");
+        let first = err.lines().next().unwrap_or("");
+        assert!(first.contains(needle), "{bad:?}: {err}");
+        assert!(err.contains("[possible values: model, physics]"), "{err}");
+        assert!(!dir.exists(), "{bad:?} created {}", dir.display());
+    }
+}
+
+/// `--quick --cubes physics` runs end to end (one run, PHD-TBD, small filter), writes
+/// the outputs of the model's cubes and says which cubes in the table and the charts.
+#[test]
+fn physics_cubes_run_quick() {
+    let dir = std::env::temp_dir().join(format!("faint-phd-physics-{}", std::process::id()));
+    let (code, err) = phd(&[
+        "--quick",
+        "--cubes",
+        "physics",
+        "--runs",
+        "1",
+        "--variants",
+        "phd-tbd",
+        "--birth-particles",
+        "100",
+        "--particles-per-target",
+        "100",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let table = std::fs::read_to_string(dir.join("table.md")).unwrap();
+    assert!(
+        table.starts_with("Cubes from the physics simulator"),
+        "{table}"
+    );
+    assert!(table.contains("| 9 | PHD-TBD | 1 |"), "{table}");
+    let chart = std::fs::read_to_string(dir.join("ospa_9db.svg")).unwrap();
+    assert!(chart.contains("1 runs, physics cubes (Fig. 5)"), "{chart}");
+    let frames = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
+    assert_eq!(frames.lines().count(), 1 + 40);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -253,7 +253,7 @@ pub const REGISTRY: &[Entry] = &[
     },
     Entry {
         name: "phd-tbd",
-        about: "SMC-PHD TBD with K-means extraction (the baseline of Pei et al. 2019)",
+        about: "SMC-PHD TBD, DBSCAN extraction (the baseline of Pei et al. 2019, K-means there)",
         input: InputKind::PowerCubes,
         default_config: || default_phd(phd::Variant::PhdTbd),
         run: |r| run_phd(r, "phd-tbd"),

@@ -151,7 +151,7 @@ impl Axis {
 
     /// The cells `lo..hi` within the response's reach of the cell holding coordinate `u`,
     /// and their factors: `S(i - u)` (`std = None`) or `exp(-(i - u)^2 / (2 std^2))`.
-    fn spread(&self, u: f64, std: Option<f64>) -> (usize, Vec<f64>) {
+    fn spread(&self, u: f64, std: Option<f64>) -> AxisSpread {
         let c = u.round() as isize;
         let reach = std.map_or(REACH, |s| (6.0 * s).ceil() as isize);
         let lo = (c - reach).max(0);
@@ -184,6 +184,9 @@ impl Axis {
         Ok(())
     }
 }
+
+/// One axis' spread of an echo: its first cell and the factors from there.
+type AxisSpread = (usize, Vec<f64>);
 
 /// The power-cube simulator's parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -356,7 +359,7 @@ impl CubePhysics {
                 });
                 (ak, q)
             });
-            self.push_frame(echo, rng, &mut out);
+            self.push_frame(echo.as_slice(), rng, &mut out);
         }
         (out, truth)
     }
@@ -366,42 +369,51 @@ impl CubePhysics {
     pub fn frame_at(&self, p: [f64; 2], v: [f64; 2], a: f64, rng: &mut Rng) -> Vec<f32> {
         let ak = a * self.swerling.draw(rng);
         let mut out = Vec::with_capacity(self.cells());
-        self.push_frame(Some((ak, Self::radar(p, v))), rng, &mut out);
+        self.push_frame(&[(ak, Self::radar(p, v))], rng, &mut out);
         out
     }
 
-    /// Appends one cube: noise, plus the echo of amplitude `a_k` at radar coordinates `q`
-    /// (range, radial velocity, azimuth) with a fresh random phase.
-    fn push_frame(&self, echo: Option<(f64, [f64; 3])>, rng: &mut Rng, out: &mut Vec<f32>) {
+    /// Appends one cube: noise, plus the echo of each `(a_k, q)` of `echoes` (amplitude
+    /// `a_k` after its Swerling draw, radar coordinates `q` = range, radial velocity,
+    /// azimuth) with a fresh random phase each. The phases are drawn in `echoes` order,
+    /// then each cell's noise I and Q, and the echoes add coherently in the cells their
+    /// spreads share: several targets in one frame, as in
+    /// `faint reproduce phd --cubes physics`.
+    pub fn push_frame(&self, echoes: &[(f64, [f64; 3])], rng: &mut Rng, out: &mut Vec<f32>) {
         let (nr, nd, na) = (self.range.n, self.doppler.n, self.azimuth.n);
         let sd = (0.5 * self.noise_power).sqrt();
-        // The echo's I and Q and its spread per axis (first cell, factors).
-        let echo = echo.map(|(ak, q)| {
-            let phi = 2.0 * std::f64::consts::PI * f64::from(rng.uniform());
-            let std = match self.response {
-                Response::Sinc => [None; 3],
-                Response::Gaussian { std } => std.map(Some),
-            };
-            let s = [
-                self.range.spread(self.range.coord(q[0]), std[0]),
-                self.doppler.spread(self.doppler.coord(q[1]), std[1]),
-                self.azimuth.spread(self.azimuth.coord(q[2]), std[2]),
-            ];
-            (ak * phi.cos(), ak * phi.sin(), s)
-        });
+        let std = match self.response {
+            Response::Sinc => [None; 3],
+            Response::Gaussian { std } => std.map(Some),
+        };
+        // Each echo's I and Q and its spread per axis (first cell, factors).
+        let echoes: Vec<(f64, f64, [AxisSpread; 3])> = echoes
+            .iter()
+            .map(|&(ak, q)| {
+                let phi = 2.0 * std::f64::consts::PI * f64::from(rng.uniform());
+                let s = [
+                    self.range.spread(self.range.coord(q[0]), std[0]),
+                    self.doppler.spread(self.doppler.coord(q[1]), std[1]),
+                    self.azimuth.spread(self.azimuth.coord(q[2]), std[2]),
+                ];
+                (ak * phi.cos(), ak * phi.sin(), s)
+            })
+            .collect();
+        // The echoes whose spread covers the row, with the row's factor `S_r S_d`.
+        let mut row: Vec<(f64, f64, &AxisSpread, f64)> = Vec::new();
         for i in 0..nr {
             for j in 0..nd {
-                // The row's factor `S_r S_d` (None: outside the spread).
-                let row = echo.as_ref().and_then(|(_, _, s)| {
+                row.clear();
+                row.extend(echoes.iter().filter_map(|(er, ei, s)| {
                     let fr = s[0].1.get(i.checked_sub(s[0].0)?)?;
                     let fd = s[1].1.get(j.checked_sub(s[1].0)?)?;
-                    Some(fr * fd)
-                });
+                    Some((*er, *ei, &s[2], fr * fd))
+                }));
                 for l in 0..na {
                     let mut re = sd * f64::from(rng.normal());
                     let mut im = sd * f64::from(rng.normal());
-                    if let (Some(g), Some((er, ei, s))) = (row, &echo) {
-                        if let Some(fb) = l.checked_sub(s[2].0).and_then(|x| s[2].1.get(x)) {
+                    for &(er, ei, sb, g) in &row {
+                        if let Some(fb) = l.checked_sub(sb.0).and_then(|x| sb.1.get(x)) {
                             re += er * g * fb;
                             im += ei * g * fb;
                         }

@@ -11,6 +11,9 @@ use crate::cli;
 use crate::instances::phd::HostFilter;
 use crate::shard::ShardArg;
 use crate::simulate::phd::{SixTargets, Variant};
+use faint_core::detect::phd::PhdConfig;
+
+use super::cubes::Cubes;
 
 /// Command-line arguments (shard files keep them, without `--shard`).
 #[derive(clap::Args, Debug, Clone, Serialize, Deserialize)]
@@ -61,6 +64,18 @@ pub struct Args {
     /// Ablation: clutter normalisation `lambda_k` of eq. 20 (preset 1), finite and > 0.
     #[arg(long)]
     pub clutter_lambda: Option<f64>,
+    /// Ablation: the filter's intensity scale in dB (default 0): the birth intensities
+    /// `U[0.75 P, 1.25 P]` and the intensity floor `0.05 P` times `10^(X/10)`, X in
+    /// [-60, 60] (the cubes keep the target power `P` of `--snr-db`).
+    #[arg(long, allow_hyphen_values = true)]
+    pub filter_intensity_db: Option<f64>,
+    /// The cubes: `model` (the preset's, drawn from the filter's own model) or
+    /// `physics` (the same targets rendered by the physics simulator: sinc response per
+    /// axis, random phase per frame; same SNR, the peak-cell power of a target at a cell
+    /// centre over the noise power). The filters are the same.
+    #[arg(long, value_enum, default_value_t = Cubes::Model)]
+    #[serde(default)]
+    pub cubes: Cubes,
     /// One shard of the runs (`--shard I/N`, see `faint merge`).
     #[command(flatten)]
     #[serde(skip)]
@@ -120,6 +135,9 @@ impl Args {
         };
         positive("--filter-q1", self.filter_q1)?;
         positive("--clutter-lambda", self.clutter_lambda)?;
+        if let Some(x) = self.filter_intensity_db {
+            cli::snr_db("--filter-intensity-db", x)?;
+        }
         if let Some(p) = self.birth_mass {
             cli::probability("--birth-mass", p)?;
         }
@@ -155,6 +173,17 @@ impl Args {
         sc
     }
 
+    /// The filter of `variant` on scene `sc` with this run's options.
+    pub(super) fn config(&self, sc: &SixTargets, variant: Variant) -> PhdConfig {
+        let mut c = sc.config(variant);
+        if let Some(x) = self.filter_intensity_db {
+            let k = 10f64.powf(x / 10.0) as f32;
+            c.birth.intensity = c.birth.intensity.map(|i| i * k);
+            c.min_intensity *= k;
+        }
+        c
+    }
+
     /// Checks every argument (one-line errors naming the argument) before any run.
     pub fn validate(&self) -> Result<()> {
         let plan = self.effective()?;
@@ -162,7 +191,7 @@ impl Args {
         for &snr in &plan.snrs {
             let sc = self.scene(snr);
             for &v in &plan.variants {
-                HostFilter::new(sc.config(v), 0)
+                HostFilter::new(self.config(&sc, v), 0)
                     .map_err(|e| anyhow::anyhow!("the options give an invalid filter: {e}"))?;
             }
         }

@@ -5,6 +5,7 @@ use std::path::Path;
 
 use anyhow::Result;
 
+use super::cubes::Cubes;
 use super::evaluation::FrameRow;
 use crate::io::{self, chart::Series};
 use crate::simulate::phd::Variant;
@@ -15,6 +16,7 @@ pub(super) fn charts(
     d: &Path,
     snr: f64,
     runs: usize,
+    cubes: Cubes,
     variants: &[Variant],
     truth_counts: &[usize],
     frames: &[FrameRow],
@@ -41,21 +43,30 @@ pub(super) fn charts(
     }
     io::chart::line_chart(
         d.join(format!("count_{snr}db.svg")),
-        &format!("Mean estimated target count, {snr} dB, {runs} runs (Fig. 3)"),
+        &format!(
+            "Mean estimated target count, {snr} dB, {runs} runs{} (Fig. 3)",
+            cubes.label()
+        ),
         "frame",
         "count",
         &count_series,
     )?;
     io::chart::line_chart(
         d.join(format!("count_std_{snr}db.svg")),
-        &format!("Std of the estimated count, {snr} dB, {runs} runs (Fig. 4)"),
+        &format!(
+            "Std of the estimated count, {snr} dB, {runs} runs{} (Fig. 4)",
+            cubes.label()
+        ),
         "frame",
         "std",
         &std_series,
     )?;
     io::chart::line_chart(
         d.join(format!("ospa_{snr}db.svg")),
-        &format!("Mean OSPA (c = 50 m, p = 2), {snr} dB, {runs} runs (Fig. 5)"),
+        &format!(
+            "Mean OSPA (c = 50 m, p = 2), {snr} dB, {runs} runs{} (Fig. 5)",
+            cubes.label()
+        ),
         "frame",
         "OSPA (m)",
         &ospa_series,

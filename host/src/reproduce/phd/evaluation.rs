@@ -4,10 +4,12 @@
 use std::time::Instant;
 
 use anyhow::Result;
+use faint_core::detect::phd::PhdConfig;
 use faint_core::detect::Detector;
 use faint_core::rng::Rng;
 use serde::Serialize;
 
+use super::cubes::{Cubes, Renderer};
 use crate::instances::phd::HostFilter;
 use crate::montecarlo::run_trial_range;
 use crate::simulate::phd::{SixTargets, Variant};
@@ -56,17 +58,22 @@ pub(super) struct SummaryRow {
     pub(super) ms_per_frame: f64,
 }
 
-fn one_run(sc: &SixTargets, variants: &[Variant], seed_rng: &mut Rng) -> Result<Vec<RunResult>> {
+fn one_run(
+    sc: &SixTargets,
+    render: &Renderer,
+    variants: &[(Variant, PhdConfig)],
+    seed_rng: &mut Rng,
+) -> Result<Vec<RunResult>> {
     let mut truth_rng = seed_rng.fork(1);
     let mut cube_rng = seed_rng.fork(2);
     let truth = sc.truth(&mut truth_rng);
     let mut filters = Vec::new();
-    for &v in variants {
+    for (v, config) in variants {
         // Each algorithm's filter seed depends on the algorithm only (the paper's three
         // keep the seeds of earlier runs whatever `--variants` selects).
-        let i = Variant::EVERY.iter().position(|&x| x == v).unwrap_or(0);
+        let i = Variant::EVERY.iter().position(|x| x == v).unwrap_or(0);
         let seed = seed_rng.fork(10 + i as u64).next_u64();
-        filters.push(crate::instances::boxed::<HostFilter>(&sc.config(v), seed)?);
+        filters.push(crate::instances::boxed::<HostFilter>(config, seed)?);
     }
     let mut res = vec![
         RunResult {
@@ -79,7 +86,7 @@ fn one_run(sc: &SixTargets, variants: &[Variant], seed_rng: &mut Rng) -> Result<
     let mut cube = Vec::new();
     let (c, p) = sc.ospa;
     for frame in &truth {
-        sc.cube(frame, &mut cube_rng, &mut cube);
+        render.frame(sc, frame, &mut cube_rng, &mut cube);
         let tr: Vec<[f64; 2]> = frame.iter().map(|t| [t.state[0], t.state[2]]).collect();
         for (f, r) in filters.iter_mut().zip(res.iter_mut()) {
             let t0 = Instant::now();
@@ -97,17 +104,21 @@ fn one_run(sc: &SixTargets, variants: &[Variant], seed_rng: &mut Rng) -> Result<
     Ok(res)
 }
 
-/// The runs `range` of scene `sc` through `variants` (run `i` on stream `i` of `seed`,
-/// whichever range, or shard, runs it).
+/// The runs `range` of scene `sc` on `cubes` through `variants` and their filters (run `i` on stream `i`
+/// of `seed`, whichever range, or shard, runs it; the same truth and cube streams
+/// whatever the cubes).
 pub(super) fn runs(
     sc: &SixTargets,
-    variants: &[Variant],
+    cubes: Cubes,
+    variants: &[(Variant, PhdConfig)],
     range: std::ops::Range<usize>,
     seed: u64,
     label: &str,
 ) -> Result<Vec<Vec<RunResult>>> {
-    let all: Vec<Result<Vec<RunResult>>> =
-        run_trial_range(seed, range, label, |_, rng| one_run(sc, variants, rng));
+    let render = Renderer::new(cubes, sc);
+    let all: Vec<Result<Vec<RunResult>>> = run_trial_range(seed, range, label, |_, rng| {
+        one_run(sc, &render, variants, rng)
+    });
     all.into_iter().collect()
 }
 

@@ -7,12 +7,16 @@
 //! frames of the std), mean OSPA on positions with `c = 50 m`, `p = 2` (Fig. 5, Table 3),
 //! and the filter's wall time per run (Table 4, cube simulation excluded).
 //!
+//! `--cubes physics` renders the same truth with the physics simulator of power cubes
+//! (sinc response, random phase per frame; `cubes.rs`) instead of the filter's model.
+//!
 //! The code is split by role: [`Args`] and its checks in `args.rs`, the runs and their
 //! statistics in `evaluation.rs`, the SVG charts in `charts.rs` and the Markdown table
 //! against the paper in `summary.rs`; [`run`] chains them, one SNR after the other.
 
 mod args;
 mod charts;
+mod cubes;
 mod evaluation;
 mod summary;
 
@@ -27,6 +31,7 @@ use args::Plan;
 use evaluation::RunResult;
 
 pub use args::Args;
+pub use cubes::{physics, render, Cubes};
 
 /// The command name in shard files.
 pub const COMMAND: &str = "reproduce phd";
@@ -44,9 +49,21 @@ fn collect(args: &Args, plan: &Plan, shard: Option<Shard>) -> Result<Vec<Batch<V
         .zip(keys(plan))
         .map(|(&snr, key)| {
             let sc = args.scene(snr);
+            let filters: Vec<_> = plan
+                .variants
+                .iter()
+                .map(|&v| (v, args.config(&sc, v)))
+                .collect();
             let seed = args.seed ^ (snr * 1000.0) as u64;
             Batch::run(key, plan.runs, shard, |range| {
-                evaluation::runs(&sc, &plan.variants, range, seed, &format!("phd {snr} dB"))
+                evaluation::runs(
+                    &sc,
+                    args.cubes,
+                    &filters,
+                    range,
+                    seed,
+                    &format!("phd {snr} dB{}", args.cubes.label()),
+                )
             })
         })
         .collect()
@@ -62,13 +79,21 @@ fn analyse(args: &Args, plan: &Plan, all: Vec<Vec<Vec<RunResult>>>) -> Result<()
         let sc = args.scene(snr);
         let (frames, rows) = evaluation::statistics(&sc, snr, &plan.variants, all);
         let truth = evaluation::truth_counts(&sc);
-        charts::charts(d, snr, plan.runs, &plan.variants, &truth, &frames)?;
+        charts::charts(
+            d,
+            snr,
+            plan.runs,
+            args.cubes,
+            &plan.variants,
+            &truth,
+            &frames,
+        )?;
         frames_csv.extend(frames);
         summary.extend(rows);
     }
     io::write_csv(d.join("frames.csv"), &frames_csv)?;
     io::write_csv(d.join("summary.csv"), &summary)?;
-    let md = summary::table(&summary);
+    let md = summary::table(&summary, args.cubes);
     io::write_text(d.join("table.md"), &md)?;
     println!("{md}");
     Ok(())

@@ -1,6 +1,7 @@
 //! The Markdown table of `faint reproduce phd`: our numbers next to the paper's
 //! Tables 2-4.
 
+use super::cubes::Cubes;
 use super::evaluation::SummaryRow;
 use crate::io;
 
@@ -11,7 +12,9 @@ pub(super) const PAPER: [(f64, [f64; 7]); 3] = [
     (5.0, [1.25, 0.93, 17.75, 15.60, 8.52, 12.85, 28.26]),
 ];
 
-pub(super) fn table(summary: &[SummaryRow]) -> String {
+/// The table of `summary`; on physics cubes a first line says so (the paper's columns
+/// stay: its figures are from its model's cubes).
+pub(super) fn table(summary: &[SummaryRow], cubes: Cubes) -> String {
     let mut rows = Vec::new();
     for s in summary {
         let paper = PAPER.iter().find(|p| p.0 == s.snr_db).map(|p| p.1);
@@ -36,7 +39,11 @@ pub(super) fn table(summary: &[SummaryRow]) -> String {
             io::fmt_opt(p_time, 2),
         ]);
     }
-    io::markdown_table(
+    let head = match cubes {
+        Cubes::Model => "",
+        Cubes::Physics => "Cubes from the physics simulator (sinc response per axis at the sub-cell offset, random phase per frame), not from the filter's model; the paper's columns are from its model's cubes.\n\n",
+    };
+    let table = io::markdown_table(
         &[
             "SNR (dB)",
             "algorithm",
@@ -52,5 +59,6 @@ pub(super) fn table(summary: &[SummaryRow]) -> String {
             "paper T4 (MATLAB)",
         ],
         &rows,
-    )
+    );
+    format!("{head}{table}")
 }
