@@ -127,10 +127,10 @@ fn default_config_finds_targets_away_from_the_preset_birth_points() {
 /// The same cubes multiplied by 10 and by 1e6 give the same detections after the noise
 /// normalisation: same count every frame, positions within 1 m in all frames but at most
 /// one, and that one within 5 m. The scaled cubes differ from the originals by f32
-/// rounding (one unit in the last place per cell); the filter absorbs it (measured: the
-/// estimates of every later frame identical), but K-means with f32 sums may move one particle to
-/// another cluster in a frame where the estimate has not converged (measured: frame 2 at
-/// scale 1e6, 2.2 m).
+/// rounding (one unit in the last place per cell); the filter absorbs it, but the
+/// clustering of an estimate that has not converged may put one particle in another
+/// cluster (measured with K-means extraction: frame 2 at scale 1e6, 2.2 m, every other
+/// frame equal).
 #[test]
 fn detections_do_not_depend_on_the_input_scale() {
     let mut pos = Rng::seed_from_u64(20_260_002);
