@@ -287,8 +287,11 @@ impl DopplerModel {
                 }
             }
         }
+        // `m >= SPAN` (checked by the callers); `checked_` keeps the divide-by-zero panic out.
         for (q, f) in self.first_of.iter_mut().enumerate() {
-            *f = (q as i64 - m as i64 - HALF_SPAN as i64).rem_euclid(m as i64) as u16;
+            *f = (q as i64 - m as i64 - HALF_SPAN as i64)
+                .checked_rem_euclid(m as i64)
+                .unwrap_or(0) as u16;
         }
         for (h, row) in self.hq.iter_mut().zip(self.rows.iter()) {
             let (mut h0, mut h1, mut h2) = (0.0f64, 0.0f64, 0.0f64);
