@@ -205,7 +205,8 @@ def main():
             if len(best) == len(PARTS):
                 break
             cache = os.path.join(OUT, spec.replace(":", "-") + ".json")
-            if (cached or not fresh) and os.path.exists(cache) and not quick:
+            # A kept result: always with --cached, otherwise unless --fresh or --quick.
+            if os.path.exists(cache) and (cached or (not fresh and not quick)):
                 with open(cache) as f:
                     r = json.load(f)
                 rows.append((family, spec, r))
@@ -214,14 +215,6 @@ def main():
                         best[part] = (spec, r)
                 continue
             if cached:
-                if not os.path.exists(cache):
-                    continue
-                with open(cache) as f:
-                    r = json.load(f)
-                rows.append((family, spec, r))
-                for part in PARTS:
-                    if r["parts"][part]["ok"] and part not in best:
-                        best[part] = (spec, r)
                 continue
             build(spec)
             elf = os.path.join(OUT, spec.replace(":", "-") + ".mps2.elf")
