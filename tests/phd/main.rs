@@ -7,8 +7,11 @@ mod births;
 mod cli;
 #[path = "../common/cli.rs"]
 mod common;
+mod dbscan_exact;
+mod dbscan_reference;
 mod filter;
 mod m4;
+mod m4_budget;
 #[path = "../common/shards.rs"]
 mod merge;
 mod shards;

@@ -5,6 +5,10 @@
 //! `six-targets` preset's particle counts (1000 per target, 500 births), on the shared three-target 9 dB scene of `faint_golden::phd` in its
 //! 32 x 32 x 32-cell firmware window (range x Doppler x azimuth around the targets).
 //!
+//! The two swarm variants run again with the swarm of the Cortex-M4 budget
+//! (`PsoConfig::cortex_m4`: at most 128 particles move per frame instead of 512), rows
+//! tagged "swarm cap 128".
+//!
 //! Each variant restarts the one static filter with `reconfigure` and runs the scene's
 //! frames; every `step` is measured (cube generation is not). Rows: mean and worst frame,
 //! per frame and per particle updated (survivors plus births). The filter (`.bss`,
@@ -19,7 +23,9 @@ use core::sync::atomic::{AtomicBool, Ordering};
 use faint_core::detect::Detector;
 
 use cortex_m_semihosting::hprintln;
-use faint_core::detect::phd::{PhdConfig, PhdStage, SmcPhdTbd, SmcPhdTbdM4, SmcPhdTbdM4Half};
+use faint_core::detect::phd::{
+    PhdConfig, PhdStage, PsoConfig, SmcPhdTbd, SmcPhdTbdM4, SmcPhdTbdM4Half,
+};
 use faint_core::math;
 use faint_core::model::power_cube::{exp_neg, log_i0, PointSpread, PowerCube, RadarCoords};
 use faint_core::rng::Rng;
@@ -92,6 +98,12 @@ pub fn run() {
         let cfg = config(FIRMWARE_WINDOW, alg, PER_TARGET, BIRTHS, 8);
         variant(det, buf, alg.name, "", RAM, cfg, FRAMES);
     }
+    // The Cortex-M4 budget: the same filter and scene, the swarm capped at 128
+    // particles per frame (`PsoConfig::cortex_m4`).
+    for alg in ALGORITHMS.iter().filter(|a| a.pso) {
+        let cfg = m4_budget(config(FIRMWARE_WINDOW, *alg, PER_TARGET, BIRTHS, 8));
+        variant(det, buf, alg.name, M4_TAG, RAM, cfg, FRAMES);
+    }
     let small = half();
     hprintln!(
         "PHD-TBD statics within 512 KiB: SmcPhdTbd<2048, 1024, 8, 8> {} B + cube window {} B = {} B",
@@ -115,7 +127,30 @@ pub fn run() {
         let cfg = config(FIRMWARE_WINDOW, alg, PER_TARGET, BIRTHS, 8);
         stages(det, buf, alg.name, cfg, FRAMES);
     }
+    for (alg, name) in ALGORITHMS.iter().filter(|a| a.pso).zip(M4_NAMES) {
+        let cfg = m4_budget(config(FIRMWARE_WINDOW, *alg, PER_TARGET, BIRTHS, 8));
+        stages(det, buf, name, cfg, FRAMES);
+    }
     kernels(det, buf);
+}
+
+/// Tag of the Cortex-M4 budget rows, and the names of their `phd stage` lines (K-means,
+/// DBSCAN).
+const M4_TAG: &str = " swarm cap 128";
+const M4_NAMES: [&str; 2] = [
+    "PSO-PHD-TBD (K-means) swarm cap 128",
+    "PSO-PHD-TBD (DBSCAN) swarm cap 128",
+];
+
+/// `cfg` with the swarm settings of `PsoConfig::cortex_m4` (the points kept).
+fn m4_budget(mut cfg: PhdConfig) -> PhdConfig {
+    if let Some(p) = cfg.pso.as_mut() {
+        *p = PsoConfig {
+            points: p.points,
+            ..PsoConfig::cortex_m4()
+        };
+    }
+    cfg
 }
 
 /// Where a frame's instructions go: the same run as [`variant`], with

@@ -6,12 +6,33 @@
 //! cells around a point. A grid cell holding `>= min_pts` points makes all of them core
 //! without distance checks, and cells whose points are all labelled are skipped during
 //! expansion, so dense particle clouds cost near-linear time. Memory: O(N) fixed arrays.
+//!
+//! A resampled particle cloud holds many copies of each particle at consecutive indices
+//! (systematic resampling keeps a particle's copies together), so the work is done once
+//! per place where that gives the same result: the points are sorted
+//! into cells by groups of consecutive indices in one cell; a copy of the previous point
+//! of its cell takes its core flag; a core point whose copy was already expanded is not
+//! expanded again (it would add nothing); and an expansion reads only each cell's
+//! pending members (not yet in a cluster), kept in their order. The clusters, their
+//! order and their members' order are those of the full search (`tests/phd/dbscan_exact.rs`
+//! checks them against it), so the estimates summed over the members keep their bits.
 
 #![allow(clippy::needless_range_loop)]
 
 use crate::{Error, Result};
 
 const UNVISITED: i32 = -2;
+/// `core` flags: a core point, a core point expanded (or a copy of one at the same place
+/// that was), not a core point.
+const CORE: u8 = 1;
+const NOT_CORE: u8 = 2;
+const EXPANDED: u8 = 3;
+
+/// The same place, bit for bit (two copies of one particle).
+#[inline]
+fn same(a: &[f32; 2], b: &[f32; 2]) -> bool {
+    a[0].to_bits() == b[0].to_bits() && a[1].to_bits() == b[1].to_bits()
+}
 /// Label of a noise point.
 pub const NOISE: i32 = -1;
 
@@ -45,10 +66,13 @@ impl DbscanParams {
 /// Grid-indexed DBSCAN workspace for up to `N` points.
 #[derive(Debug, Clone)]
 pub struct Dbscan<const N: usize> {
+    /// Grid key of each group of consecutive points in one cell (first index in `queue`
+    /// while the runs are built).
     key: [u64; N],
     order: [u32; N],
     run_of: [u32; N],
     run_start: [u32; N],
+    /// Members of each run; during the expansion, the length of its pending prefix.
     run_len: [u32; N],
     run_key: [u64; N],
     run_free: [u32; N],
@@ -120,7 +144,8 @@ impl<const N: usize> Dbscan<N> {
         }
     }
 
-    /// The points of run `r` (empty out of range).
+    /// The points of run `r` (empty out of range): all of them until [`Dbscan::cores`]
+    /// has run, then the run's pending prefix (see [`Dbscan::run`]).
     #[inline]
     fn members(&self, r: usize) -> &[u32] {
         match (self.run_start.get(r), self.run_len.get(r)) {
@@ -132,48 +157,106 @@ impl<const N: usize> Dbscan<N> {
         }
     }
 
-    fn is_core(&mut self, p: usize, pts: &[[f32; 2]], eps2: f32, min_pts: usize) -> bool {
-        let (Some(&cp), Some(&own), Some(&k), Some(&pp)) = (
-            self.core.get(p),
-            self.run_of.get(p),
-            self.key.get(p),
-            pts.get(p),
-        ) else {
-            return false;
-        };
-        if cp != 0 {
-            return cp == 1;
-        }
-        let own = own as usize;
-        // With the shortcut every point of the own cell is a neighbour; without it the
-        // own cell is searched like the others.
-        let (own, mut count) = if self.shortcut {
-            (own, self.run_len.get(own).map_or(0, |&l| l as usize))
-        } else {
-            (usize::MAX, 0)
-        };
-        if count < min_pts {
-            let (gx, gy) = ((k >> 32) as u32, k as u32);
-            self.for_block(gx, gy, |r| {
-                if r != own {
-                    for &q in self.members(r) {
+    /// Core flags (`core`: 1 core, 2 not) of every point, run by run: a point is core
+    /// when at least `min_pts` points (itself included) lie within `eps`. With the
+    /// shortcut every point of the own grid cell is a neighbour (the cell fits in the
+    /// eps disc), so a cell of `min_pts` points or more is core throughout; otherwise
+    /// the other cells of the 5 x 5 block are searched, their runs looked up once per
+    /// cell, stopping at `min_pts`.
+    fn cores(&mut self, pts: &[[f32; 2]], eps2: f32, min_pts: usize) {
+        for own in 0..self.n_runs {
+            let (Some(&k), Some(&len)) = (self.run_key.get(own), self.run_len.get(own)) else {
+                continue;
+            };
+            let len = len as usize;
+            let base = if self.shortcut { len } else { 0 };
+            let mut runs = [0u32; 25];
+            let mut nr = 0usize;
+            if base < min_pts {
+                self.for_block((k >> 32) as u32, k as u32, |r| {
+                    if r != own || !self.shortcut {
+                        if let Some(slot) = runs.get_mut(nr) {
+                            *slot = r as u32;
+                            nr += 1;
+                        }
+                    }
+                    true
+                });
+            }
+            let runs = runs.get(..nr).unwrap_or(&[]);
+            // The previous member's point and flag: a point at the same place (the
+            // resampled filter's copies) has the same neighbours.
+            let mut prev: Option<([f32; 2], u8)> = None;
+            for j in 0..len {
+                let Some(&p) = self
+                    .run_start
+                    .get(own)
+                    .and_then(|&s| self.order.get(s as usize + j))
+                else {
+                    continue;
+                };
+                let Some(&pp) = pts.get(p as usize) else {
+                    continue;
+                };
+                if let Some((_, c)) = prev.filter(|(q, _)| same(q, &pp)) {
+                    if let Some(cp) = self.core.get_mut(p as usize) {
+                        *cp = c;
+                    }
+                    continue;
+                }
+                let mut count = base;
+                'block: for &r in runs {
+                    if count >= min_pts {
+                        break;
+                    }
+                    for &q in self.members(r as usize) {
                         let Some(q) = pts.get(q as usize) else {
                             continue;
                         };
                         let (dx, dy) = (q[0] - pp[0], q[1] - pp[1]);
                         if dx * dx + dy * dy <= eps2 {
                             count += 1;
+                            if count >= min_pts {
+                                break 'block;
+                            }
                         }
                     }
                 }
-                count < min_pts
-            });
+                let c = if count >= min_pts { CORE } else { NOT_CORE };
+                if let Some(cp) = self.core.get_mut(p as usize) {
+                    *cp = c;
+                }
+                prev = Some((pp, c));
+            }
         }
-        let c = count >= min_pts;
-        if let Some(cp) = self.core.get_mut(p) {
-            *cp = if c { 1 } else { 2 };
+    }
+
+    /// Marks `q` and the points next to it in input order at the same place as
+    /// [`EXPANDED`] (the resampled filter's copies of one particle have consecutive
+    /// indices): expanding one of them again would add nothing, since every free point
+    /// within `eps` of that place (and of its own cell, with the shortcut) was labelled by
+    /// the first, and labels are never taken back.
+    fn mark_expanded(&mut self, q: usize, pts: &[[f32; 2]]) {
+        let Some(&pq) = pts.get(q) else {
+            return;
+        };
+        if let Some(c) = self.core.get_mut(q) {
+            *c = EXPANDED;
         }
-        c
+        let mut i = q;
+        while i > 0 && pts.get(i - 1).is_some_and(|p| same(p, &pq)) {
+            i -= 1;
+            if let Some(c) = self.core.get_mut(i) {
+                *c = EXPANDED;
+            }
+        }
+        let mut i = q + 1;
+        while pts.get(i).is_some_and(|p| same(p, &pq)) {
+            if let Some(c) = self.core.get_mut(i) {
+                *c = EXPANDED;
+            }
+            i += 1;
+        }
     }
 
     /// Clusters `pts` (at most `N`; NaN/inf coordinates are [`Error::NonFinite`]).
@@ -225,57 +308,116 @@ impl<const N: usize> Dbscan<N> {
         self.shortcut = shortcut;
         let eps2 = params.eps * params.eps;
         let grid = |v: f32, lo: f32| -> u32 { (half(v, lo) / half_side) as u32 };
+        // Groups: maximal ranges of consecutive indices in one grid cell (a resampled
+        // cloud's copies of a particle are consecutive), key in `key[g]`, first index in
+        // `queue[g]`. Sorting the groups by (key, group) orders the points by (key,
+        // index), as sorting the points would, for a fraction of the work.
+        let mut ng = 0usize;
+        let mut last = None;
         for (i, p) in pts.iter().enumerate() {
-            self.key[i] = pack(grid(p[0], minx), grid(p[1], miny));
-            self.order[i] = i as u32;
-            self.labels[i] = UNVISITED;
-            self.core[i] = 0;
+            let k = pack(grid(p[0], minx), grid(p[1], miny));
+            if last != Some(k) {
+                // ng <= i < N
+                if let (Some(kg), Some(sg), Some(o)) = (
+                    self.key.get_mut(ng),
+                    self.queue.get_mut(ng),
+                    self.order.get_mut(ng),
+                ) {
+                    (*kg, *sg, *o) = (k, i as u32, ng as u32);
+                }
+                ng += 1;
+                last = Some(k);
+            }
+            if let (Some(l), Some(c)) = (self.labels.get_mut(i), self.core.get_mut(i)) {
+                (*l, *c) = (UNVISITED, 0);
+            }
         }
-        {
+        if let Some(groups) = self.order.get_mut(..ng) {
             let key = &self.key;
-            crate::sort::sort_unstable_by_key(&mut self.order[..n], |&i| {
-                (key.get(i as usize).copied().unwrap_or(u64::MAX), i)
+            crate::sort::sort_unstable_by_key(groups, |&g| {
+                (key.get(g as usize).copied().unwrap_or(u64::MAX), g)
             });
         }
-        self.n_runs = 0;
-        let mut s = 0usize;
-        let order = &self.order[..n];
-        while let Some(&first) = order.get(s) {
-            let k = self.key.get(first as usize).copied().unwrap_or(0);
-            let mut e = s;
-            while let Some(&o) = order.get(e) {
-                match (self.key.get(o as usize), self.run_of.get_mut(o as usize)) {
-                    (Some(&ko), Some(ro)) if ko == k => *ro = self.n_runs as u32,
-                    _ => break,
-                }
-                e += 1;
+        // Runs: the sorted groups of one key. Counted first, then the groups are laid
+        // out from the last: sorted group `j` starts at position `>= j` (every group
+        // has a point), so writing it never overwrites the unread entries `order[..j]`.
+        let mut n_runs = 0usize;
+        let mut last = None;
+        for &g in self.order.iter().take(ng) {
+            let k = self.key.get(g as usize).copied();
+            if last != Some(k) {
+                n_runs += 1;
+                last = Some(k);
             }
-            let r = self.n_runs;
-            if let (Some(rs), Some(rl), Some(rf), Some(rk)) = (
+        }
+        self.n_runs = n_runs;
+        let mut pos = n;
+        let mut r = n_runs;
+        let mut last = None;
+        for j in (0..ng).rev() {
+            let Some(&g) = self.order.get(j) else {
+                break;
+            };
+            let g = g as usize;
+            let (Some(&k), Some(&s)) = (self.key.get(g), self.queue.get(g)) else {
+                break;
+            };
+            let e = if g + 1 < ng {
+                self.queue.get(g + 1).map_or(n, |&e| e as usize)
+            } else {
+                n
+            };
+            let s = s as usize;
+            let len = e.saturating_sub(s);
+            if last != Some(k) {
+                last = Some(k);
+                r = r.saturating_sub(1);
+                if let (Some(rl), Some(rk)) = (self.run_len.get_mut(r), self.run_key.get_mut(r)) {
+                    (*rl, *rk) = (0, k);
+                }
+            }
+            pos = pos.saturating_sub(len);
+            for t in 0..len {
+                if let (Some(o), Some(ro)) =
+                    (self.order.get_mut(pos + t), self.run_of.get_mut(s + t))
+                {
+                    (*o, *ro) = ((s + t) as u32, r as u32);
+                }
+            }
+            if let (Some(rs), Some(rl), Some(rf)) = (
                 self.run_start.get_mut(r),
                 self.run_len.get_mut(r),
                 self.run_free.get_mut(r),
-                self.run_key.get_mut(r),
             ) {
-                (*rs, *rl, *rf, *rk) = (s as u32, (e - s) as u32, (e - s) as u32, k);
+                *rs = pos as u32;
+                *rl += len as u32;
+                *rf = *rl;
             }
-            self.n_runs += 1;
-            s = e.max(s + 1);
         }
+        self.cores(pts, eps2, params.min_pts);
+        // From here a run's `order[start..start + run_len]` is its pending prefix: its
+        // members that may still join a cluster (unvisited or noise), in their sorted
+        // order, plus cluster seeds labelled since the run was last scanned. A scan
+        // drops the members it labels and those labelled before, keeping the others in
+        // order, so each query sees the candidates in the order of the whole run
+        // without re-reading the members already in a cluster.
         let mut clusters = 0usize;
         let mut qlen = 0usize;
         for p in 0..n {
-            if self.labels[p] != UNVISITED {
+            let (Some(lab), Some(&c)) = (self.labels.get_mut(p), self.core.get(p)) else {
+                break;
+            };
+            if *lab != UNVISITED {
                 continue;
             }
-            if !self.is_core(p, pts, eps2, params.min_pts) {
-                self.labels[p] = NOISE;
+            if c == NOT_CORE {
+                *lab = NOISE;
                 continue;
             }
             let id = clusters as i32;
             clusters += 1;
             let start = qlen;
-            self.labels[p] = id;
+            *lab = id;
             if let Some(f) = self
                 .run_of
                 .get(p)
@@ -291,16 +433,19 @@ impl<const N: usize> Dbscan<N> {
             while let Some(&q) = self.queue.get(head).filter(|_| head < qlen) {
                 let q = q as usize;
                 head += 1;
-                if !self.is_core(q, pts, eps2, params.min_pts) {
+                // Not core, or a copy of a point already expanded: nothing to add.
+                if self.core.get(q).is_none_or(|&c| c != CORE) {
                     continue;
                 }
-                let (Some(&k), Some(&pq), Some(&own)) =
-                    (self.key.get(q), pts.get(q), self.run_of.get(q))
-                else {
+                self.mark_expanded(q, pts);
+                let (Some(&pq), Some(&own)) = (pts.get(q), self.run_of.get(q)) else {
+                    continue;
+                };
+                let own = own as usize;
+                let Some(&k) = self.run_key.get(own) else {
                     continue;
                 };
                 let (gx, gy) = ((k >> 32) as u32, k as u32);
-                let own = own as usize;
                 let mut r_lo = 0usize;
                 // Collect the block's runs first (borrowck: for_block borrows self).
                 let mut runs = [0u32; 25];
@@ -321,11 +466,13 @@ impl<const N: usize> Dbscan<N> {
                         continue;
                     };
                     let st = st as usize;
-                    let Some(members) = self.order.get(st..st + len as usize) else {
-                        continue;
-                    };
-                    for &o in members {
-                        let o = o as usize;
+                    let take_all = self.shortcut && r == own;
+                    let mut kept = 0usize;
+                    for i in 0..len as usize {
+                        let Some(&o32) = self.order.get(st + i) else {
+                            break;
+                        };
+                        let o = o32 as usize;
                         let (Some(lab), Some(po)) = (self.labels.get_mut(o), pts.get(o)) else {
                             continue;
                         };
@@ -333,16 +480,25 @@ impl<const N: usize> Dbscan<N> {
                             continue;
                         }
                         let (dx, dy) = (po[0] - pq[0], po[1] - pq[1]);
-                        if (self.shortcut && r == own) || dx * dx + dy * dy <= eps2 {
+                        if take_all || dx * dx + dy * dy <= eps2 {
                             *lab = id;
                             if let Some(f) = self.run_free.get_mut(r) {
                                 *f -= 1;
                             }
                             if let Some(slot) = self.queue.get_mut(qlen) {
-                                *slot = o as u32;
+                                *slot = o32;
                             }
                             qlen += 1;
+                        } else {
+                            // kept <= i
+                            if let Some(d) = self.order.get_mut(st + kept) {
+                                *d = o32;
+                            }
+                            kept += 1;
                         }
+                    }
+                    if let Some(l) = self.run_len.get_mut(r) {
+                        *l = kept as u32;
                     }
                 }
             }
