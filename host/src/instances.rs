@@ -64,6 +64,57 @@ pub mod mht {
     pub type Mht = MhtTbd<PLOTS, SCANS, RANGE_CELLS, ANGLE_CELLS, TRACKS>;
     /// The host's classic Hough TBD.
     pub type Classic = ClassicHough<RANGE_CELLS, ANGLE_CELLS, PEAKS>;
+
+    /// Plots per scan of the STM32H743's MHT-TBD (the largest `mht:P` of the firmware's
+    /// board-fit matrix that fits the part; `faint reproduce mht --plots 512`).
+    pub const BOARD_PLOTS: usize = 512;
+    /// Confirmed tracks of the firmware's MHT-TBD (`--tracks 16`).
+    pub const BOARD_TRACKS: usize = 16;
+    /// The STM32H743's MHT-TBD: the firmware's `MhtTbd<512, 30, 256, 180, 16>`, on the
+    /// host's grid.
+    pub type Board = MhtTbd<BOARD_PLOTS, SCANS, RANGE_CELLS, ANGLE_CELLS, BOARD_TRACKS>;
+    /// The plot capacities `faint reproduce mht --plots` accepts: the host's and the
+    /// board's.
+    pub const REPRODUCE_PLOTS: [usize; 2] = [PLOTS, BOARD_PLOTS];
+    /// The track capacities `faint reproduce mht --tracks` accepts.
+    pub const REPRODUCE_TRACKS: [usize; 2] = [TRACKS, BOARD_TRACKS];
+
+    // The board instance is the firmware's type and the host's the core's host type.
+    const _: fn(faint_core::detect::mht::MhtTbdM4) -> Board = |d| d;
+    const _: fn(faint_core::detect::mht::MhtTbdHost) -> Mht = |d| d;
+
+    /// Runs `$body` with `$p` and `$t` consts, the plot and track capacities of the
+    /// instance with `$plots` plots per scan and `$tracks` tracks ([`BOARD_PLOTS`],
+    /// [`BOARD_TRACKS`]: the board's; any other value: the host's [`PLOTS`], [`TRACKS`]).
+    /// The one place a capacity picks an instance.
+    macro_rules! with_mht_capacity {
+        ($plots:expr, $tracks:expr, |$p:ident, $t:ident| $body:expr) => {{
+            use $crate::instances::mht as im_;
+            match ($plots == im_::BOARD_PLOTS, $tracks == im_::BOARD_TRACKS) {
+                (true, true) => {
+                    const $p: usize = im_::BOARD_PLOTS;
+                    const $t: usize = im_::BOARD_TRACKS;
+                    $body
+                }
+                (true, false) => {
+                    const $p: usize = im_::BOARD_PLOTS;
+                    const $t: usize = im_::TRACKS;
+                    $body
+                }
+                (false, true) => {
+                    const $p: usize = im_::PLOTS;
+                    const $t: usize = im_::BOARD_TRACKS;
+                    $body
+                }
+                (false, false) => {
+                    const $p: usize = im_::PLOTS;
+                    const $t: usize = im_::TRACKS;
+                    $body
+                }
+            }
+        }};
+    }
+    pub(crate) use with_mht_capacity;
 }
 
 /// The SMC-PHD / PSO-PHD detectors (Pei et al.'s six-target scene).

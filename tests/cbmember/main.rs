@@ -3,6 +3,7 @@
 //! family.
 
 mod births;
+mod board;
 mod cli;
 #[path = "../common/cli.rs"]
 mod common;

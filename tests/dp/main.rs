@@ -5,6 +5,7 @@
 //! `faint reproduce dp --quick`. One test binary for the family.
 
 mod analysis;
+mod board;
 mod cli;
 mod detector;
 mod host;

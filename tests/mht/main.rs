@@ -3,6 +3,7 @@
 //! test binary for the family.
 #![allow(clippy::needless_range_loop)]
 
+mod board;
 mod calibration;
 mod cli;
 #[path = "../common/cli.rs"]

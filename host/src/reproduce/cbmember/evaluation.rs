@@ -65,10 +65,20 @@ pub struct Row {
     pub pd_lo: f64,
     /// Upper end.
     pub pd_hi: f64,
+    /// Standard error of `pd` over runs: the standard deviation of the runs' detected
+    /// fractions over `sqrt(runs)`, which, unlike the Clopper-Pearson interval, allows for
+    /// the correlation of a run's frames. Absent (0) in an older `curves.csv`.
+    #[serde(default)]
+    pub pd_se_runs: f64,
     /// Reported components per scored frame (target-free runs: false alarms per frame).
     pub reported_per_frame: f64,
     /// Mean OSPA over all frames.
     pub ospa: f64,
+    /// Standard error of `ospa`: the standard deviation of the runs' mean OSPA over
+    /// `sqrt(runs)` (runs are independent, a run's frames are not). Absent (0) in a
+    /// `curves.csv` written before it existed.
+    #[serde(default)]
+    pub ospa_se: f64,
     /// Mean OSPA after the burn-in.
     pub ospa_after_burn_in: f64,
     /// RMSE of the matched component's range (m).
@@ -192,6 +202,14 @@ pub(super) fn point_rows(
     let mut rows = Vec::new();
     for (k, f) in fs.iter().enumerate() {
         let mut s = RunStats::default();
+        let per_run: Vec<f64> = all
+            .iter()
+            .map(|r| r[k].ospa_all / sc.frames.max(1) as f64)
+            .collect();
+        let pd_per_run: Vec<f64> = all
+            .iter()
+            .map(|r| r[k].hits as f64 / r[k].scored.max(1) as f64)
+            .collect();
         for r in all {
             let x = r[k];
             s.hits += x.hits;
@@ -215,8 +233,10 @@ pub(super) fn point_rows(
             pd: pd.p,
             pd_lo: pd.lo,
             pd_hi: pd.hi,
+            pd_se_runs: standard_error(&pd_per_run),
             reported_per_frame: s.reported as f64 / s.scored.max(1) as f64,
             ospa: s.ospa_all / (runs * sc.frames) as f64,
+            ospa_se: standard_error(&per_run),
             ospa_after_burn_in: s.ospa_burn / s.scored.max(1) as f64,
             rmse_range_m: if s.n_err > 0 {
                 (s.err_r2 / n_err).sqrt()
@@ -231,6 +251,18 @@ pub(super) fn point_rows(
         });
     }
     rows
+}
+
+/// Standard error of the mean of `x` (sample standard deviation over `sqrt(n)`; 0 for
+/// fewer than two values).
+fn standard_error(x: &[f64]) -> f64 {
+    let n = x.len();
+    if n < 2 {
+        return 0.0;
+    }
+    let m = x.iter().sum::<f64>() / n as f64;
+    let v = x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1) as f64;
+    (v / n as f64).sqrt()
 }
 
 pub(super) fn joint(sc: &RotorUav, particles: usize) -> FilterSpec {

@@ -8,7 +8,8 @@
 //! with `zeta_v` matched to the physical peak width), `B` estimated, the quantised `u8` map.
 //!
 //! Per SNR point and run: one truth and 40 maps; every filter of a set runs on the same
-//! maps (set "base": joint at each `--particles` and at 1500, Doppler-only at 1500). Run
+//! maps (sets "base" and "fa": joint at each `--particles` and at 1500, Doppler-only at
+//! 1500). Run
 //! `i` of SNR point `j` uses `Rng::from_stream(derive_seed(seed, j), i)` in every set
 //! (common random numbers across sets), so results are identical for any thread count.
 //! Scores (preset): after a 5-frame burn-in a frame is a detection when a reported
@@ -157,6 +158,7 @@ fn sets(e: &Effective, seed: u64) -> Vec<SetSpec> {
         }
     }
     if want("fa") {
+        let parts = fig11(e);
         out.push(SetSpec::new(
             "target-free",
             &e.snrs,
@@ -166,7 +168,11 @@ fn sets(e: &Effective, seed: u64) -> Vec<SetSpec> {
                 sc.present = false;
                 sc
             },
-            |sc| vec![joint(sc, 1500), doppler(sc, 1500)],
+            move |sc| {
+                let mut v = vec![joint(sc, 1500), doppler(sc, 1500)];
+                v.extend(parts.iter().filter(|&&p| p != 1500).map(|&p| joint(sc, p)));
+                v
+            },
         ));
     }
     if want("ablation") {

@@ -4,10 +4,23 @@
 
 use anyhow::{anyhow, Result};
 use faint_core::detect::dp::{DpConfig, DpTrack, Method, Transition};
+use faint_core::dp_tbd;
 use faint_core::rng::Rng;
 use serde::Serialize;
 
-use crate::simulate::dp::{qb_for, with_dp, DimPoint, Run, Truth, HISTORY, METHODS};
+use crate::simulate::dp::{boxed, qb_for, with_dp, DimPoint, Run, Truth, HISTORY, METHODS, SIDE};
+
+/// The second order with `i8` merit cells (`--second-bits 8`), `q_B = 9`: the merit
+/// memory of the STM32H743's `dp-second:128:8` image (which keeps `L = 8` frames of
+/// back-pointers; `L` changes only the recoverable track, not the merits).
+pub type Second9I8 = dp_tbd!(SecondOrder, SIDE, 9, HISTORY, i8);
+/// The same at `q_B = 25` (2 px/frame).
+pub type Second25I8 = dp_tbd!(SecondOrder, SIDE, 25, HISTORY, i8);
+
+/// The input LSB of `i8` merits (intensity units): an `i8` cell holds pixels up to
+/// `+-63` LSB, so the preset's `1/16` would clip them at 3.9 (2.6 sigma); the firmware's
+/// `i8` rows and board images use 0.25 (pixels up to 15.75, 10.5 sigma).
+pub const I8_LSB: f32 = 0.25;
 
 /// What one detector showed on one target run, frame by frame (index `n - 1` after `n`
 /// frames).
@@ -110,6 +123,9 @@ pub struct Variant {
     pub transition: Option<Transition>,
     /// Replaces `q_B`.
     pub qb: Option<usize>,
+    /// The second order with `i8` merit cells and the input LSB [`I8_LSB`] (the other
+    /// methods unchanged).
+    pub second_i8: bool,
 }
 
 impl Variant {
@@ -124,8 +140,32 @@ impl Variant {
         if let Some(t) = self.transition {
             c.transition = t;
         }
+        if self.second_i8 && method == Method::SecondOrder {
+            c.lsb = I8_LSB;
+        }
         c
     }
+}
+
+/// Runs `$body` with `$det: Box<_>` the detector of `$method` and `$qb` configured with
+/// `$cfg` under variant `$v`: the `i8` second order ([`Second9I8`], [`Second25I8`]) with
+/// [`Variant::second_i8`], else the host's ([`with_dp!`]). The one place the variant
+/// picks a detector type.
+macro_rules! with_variant_dp {
+    ($v:expr, $method:expr, $qb:expr, $cfg:expr, |$det:ident| $body:expr) => {{
+        match ($v.second_i8 && $method == Method::SecondOrder, $qb) {
+            (true, 9) => {
+                let $det = boxed::<Second9I8>($cfg)?;
+                $body
+            }
+            (true, 25) => {
+                let $det = boxed::<Second25I8>($cfg)?;
+                $body
+            }
+            (true, q) => anyhow::bail!("q_b = {q}: must be 9 or 25"),
+            (false, _) => with_dp!($method, $qb, $cfg, |$det| $body),
+        }
+    }};
 }
 
 /// The three methods' traces on target run `i` at `snr` and `speed` (stream
@@ -144,7 +184,7 @@ pub fn target_run(
         .iter()
         .map(|&m| {
             let cfg = v.config(m, speed);
-            with_dp!(m, qb, &cfg, |det| {
+            with_variant_dp!(v, m, qb, &cfg, |det| {
                 let mut det = det;
                 trace(det.as_mut(), sc, &run)
             })
@@ -160,7 +200,7 @@ pub fn noise_run(sc: &DimPoint, speed: u8, v: &Variant, rng: &mut Rng) -> Result
         .iter()
         .map(|&m| {
             let cfg = v.config(m, speed);
-            with_dp!(m, qb, &cfg, |det| {
+            with_variant_dp!(v, m, qb, &cfg, |det| {
                 let mut det = det;
                 best_merits(det.as_mut(), &run)
             })

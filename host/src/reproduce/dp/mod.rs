@@ -39,7 +39,9 @@ use serde::Deserialize;
 pub mod eval;
 pub mod fig5;
 
-pub use eval::{noise_run, target_run, trace, track_error, Trace, Variant};
+pub use eval::{
+    noise_run, target_run, trace, track_error, Second25I8, Second9I8, Trace, Variant, I8_LSB,
+};
 
 /// Command-line arguments of `faint reproduce dp` (shard files keep them, without
 /// `--shard`).
@@ -68,6 +70,12 @@ pub struct Args {
     /// `q_B` of every method at every speed (9 or 25; default 9 at 1 px/frame, 25 at 2).
     #[arg(long)]
     pub qb: Option<usize>,
+    /// Merit cell bits of the second order: 16 (`i16`, the default) or 8 (`i8` cells
+    /// with the input LSB 0.25, the STM32H743's `dp-second:128:8`); Arnold and Pulford
+    /// keep `i16`.
+    #[arg(long, default_value_t = 16)]
+    #[serde(default = "sixteen")]
+    pub second_bits: u8,
     /// Skip Fig. 5 (the merit distributions).
     #[arg(long)]
     pub no_fig5: bool,
@@ -85,6 +93,10 @@ pub struct Args {
     #[command(flatten)]
     #[serde(skip)]
     pub shard: crate::shard::ShardArg,
+}
+
+fn sixteen() -> u8 {
+    16
 }
 
 /// Arguments after the `--quick` defaults.
@@ -139,6 +151,11 @@ impl Args {
         if let Some(qb) = self.qb {
             ensure!(qb == 9 || qb == 25, "--qb must be 9 or 25, got {qb}");
         }
+        ensure!(
+            self.second_bits == 8 || self.second_bits == 16,
+            "--second-bits must be 8 or 16, got {}",
+            self.second_bits
+        );
         Ok(Effective {
             runs,
             snrs,
@@ -148,6 +165,7 @@ impl Args {
             variant: Variant {
                 transition,
                 qb: self.qb,
+                second_i8: self.second_bits == 8,
             },
         })
     }
@@ -864,7 +882,7 @@ fn summary(
     md.push_str("# DP-TBD: Wang, Zhang 2016 (Fig. 5-7)\n\n");
     let cmd = std::env::args().collect::<Vec<_>>().join(" ");
     md.push_str(&format!(
-        "Command: `{cmd}`. Runs per point: {}, noise-only runs per speed: {} (calibration) + {} (check), frames: {}, seed {}, transition: {}, q_B: {}.\n\n",
+        "Command: `{cmd}`. Runs per point: {}, noise-only runs per speed: {} (calibration) + {} (check), frames: {}, seed {}, transition: {}, q_B: {}, second-order merits: {}.\n\n",
         e.runs,
         e.noise_runs,
         e.noise_runs,
@@ -879,6 +897,11 @@ fn summary(
         e.variant
             .qb
             .map_or("preset (9 at 1 px/frame, 25 at 2)".to_string(), |q| q.to_string()),
+        if e.variant.second_i8 {
+            "i8, LSB 0.25"
+        } else {
+            "i16"
+        },
     ));
     md.push_str("## Image-level thresholds (P_FA = 0.01)\n\n");
     let mut rows = Vec::new();

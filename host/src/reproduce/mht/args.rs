@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 
 use crate::cli;
+use crate::instances::mht::{PLOTS, REPRODUCE_PLOTS, REPRODUCE_TRACKS, TRACKS};
 use crate::shard::ShardArg;
 use crate::stats::detection::proportion;
 
@@ -66,10 +67,29 @@ pub struct Args {
     /// simulated; a result at this floor is flagged), 1 to 255.
     #[arg(long, default_value_t = 3)]
     pub calib_min_gamma: u8,
+    /// MHT-TBD's plot capacity per scan: 640 (the host's) or 512 (the STM32H743's; with
+    /// `--tracks 16` the firmware's `MhtTbd<512, 30, 256, 180, 16>`); plots, gated pairs
+    /// and chains beyond it are skipped and counted. Also the calibration's detector.
+    #[arg(long, default_value_t = PLOTS)]
+    #[serde(default = "host_plots")]
+    pub plots: usize,
+    /// MHT-TBD's track capacity: 32 (the host's) or 16 (the firmware's); peaks beyond it
+    /// are dropped weakest first and counted. Also the calibration's detector.
+    #[arg(long, default_value_t = TRACKS)]
+    #[serde(default = "host_tracks")]
+    pub tracks: usize,
     /// One shard of the trials (`--shard I/N`, see `faint merge`).
     #[command(flatten)]
     #[serde(skip)]
     pub shard: ShardArg,
+}
+
+fn host_plots() -> usize {
+    PLOTS
+}
+
+fn host_tracks() -> usize {
+    TRACKS
 }
 
 /// `--gamma-from` values.
@@ -148,6 +168,16 @@ impl Args {
             cli::count("--gamma1", g.into(), 1..=255)?;
         }
         cli::count("--calib-min-gamma", args.calib_min_gamma.into(), 1..=255)?;
+        anyhow::ensure!(
+            REPRODUCE_PLOTS.contains(&args.plots),
+            "--plots must be one of {REPRODUCE_PLOTS:?} (the compiled-in capacities), got {}",
+            args.plots
+        );
+        anyhow::ensure!(
+            REPRODUCE_TRACKS.contains(&args.tracks),
+            "--tracks must be one of {REPRODUCE_TRACKS:?} (the compiled-in capacities), got {}",
+            args.tracks
+        );
         anyhow::ensure!(
             !(args.gamma1.is_some() && args.gamma_from == GammaFrom::Sim),
             "--gamma1 and --gamma-from sim exclude each other"

@@ -8,11 +8,11 @@ use faint_core::detect::mht::MhtTbd;
 use faint_core::detect::Detector;
 
 use super::args::{Args, CalibRule, GammaFrom, ModelChoice, Sizes};
-use super::detectors::detectors;
+use super::detectors::detectors_with;
 use crate::analysis::mht::{
     self as model, max_count, CellModel, ChainSource, CompoundModel, ModelParams,
 };
-use crate::instances::mht::{ANGLE_CELLS, RANGE_CELLS};
+use crate::instances::mht::{with_mht_capacity, ANGLE_CELLS, PLOTS, RANGE_CELLS, TRACKS};
 use crate::simulate::mht::SeaClutter;
 
 /// Clutter-only false-track counts per candidate `gamma_1` (index = `gamma_1`).
@@ -34,7 +34,31 @@ pub struct FalseTrackCounts {
 /// censored and integrated once; [`MhtTbd::redetect`] re-runs only the threshold,
 /// condensing and track confirmation per candidate, and only for candidates up to the
 /// period's largest DMHT count (no cell reaches a higher `gamma_1`: no peak, no track).
+/// The host's MHT-TBD; [`false_track_counts_at`] takes the plot capacity.
 pub fn false_track_counts(
+    sc: &SeaClutter,
+    periods: usize,
+    seed: u64,
+    floor: u8,
+) -> FalseTrackCounts {
+    false_track_counts_at((PLOTS, TRACKS), sc, periods, seed, floor)
+}
+
+/// [`false_track_counts`] with the MHT-TBD instance of `capacity = (plots per scan,
+/// tracks)` (the host's or the board's, see `instances::mht`).
+pub fn false_track_counts_at(
+    capacity: (usize, usize),
+    sc: &SeaClutter,
+    periods: usize,
+    seed: u64,
+    floor: u8,
+) -> FalseTrackCounts {
+    with_mht_capacity!(capacity.0, capacity.1, |P, T| counts::<P, T>(
+        sc, periods, seed, floor
+    ))
+}
+
+fn counts<const P: usize, const T: usize>(
     sc: &SeaClutter,
     periods: usize,
     seed: u64,
@@ -53,7 +77,7 @@ pub fn false_track_counts(
         &format!("calib lambda={}", sc.lambda),
         |_, rng| {
             let mut out = vec![0u16; n + 1];
-            let Ok((mut m, _)) = detectors(&null_sc, g_step, 1) else {
+            let Ok((mut m, _)) = detectors_with::<P, T>(&null_sc, g_step, 1) else {
                 return out;
             };
             let tr = null_sc.generate(rng);
@@ -99,7 +123,12 @@ pub const PILOT_PERIODS: usize = 200;
 /// above any `Pfa` worth calibrating (< 1e-2), so the calibration fails there and never
 /// needs the candidates below, which are the costly ones (many peaks to recover).
 pub fn pilot_floor(sc: &SeaClutter, seed: u64, min_gamma: u8) -> u8 {
-    let c = false_track_counts(sc, PILOT_PERIODS, seed, min_gamma);
+    pilot_floor_at((PLOTS, TRACKS), sc, seed, min_gamma)
+}
+
+/// [`pilot_floor`] with the MHT-TBD instance of `capacity = (plots per scan, tracks)`.
+pub fn pilot_floor_at(capacity: (usize, usize), sc: &SeaClutter, seed: u64, min_gamma: u8) -> u8 {
+    let c = false_track_counts_at(capacity, sc, PILOT_PERIODS, seed, min_gamma);
     let min = usize::from(c.floor);
     (min..c.with_track.len())
         .rev()
@@ -279,12 +308,14 @@ pub(super) fn gammas(
     let g1 = if let Some(g) = args.gamma1 {
         usize::from(g)
     } else if args.gamma_from == GammaFrom::Sim {
-        let floor = pilot_floor(
+        let floor = pilot_floor_at(
+            (args.plots, args.tracks),
             sc,
             faint_core::rng::derive_seed(args.seed ^ PILOT_TAG, li as u64),
             args.calib_min_gamma,
         );
-        let c = false_track_counts(
+        let c = false_track_counts_at(
+            (args.plots, args.tracks),
             sc,
             calib_periods,
             faint_core::rng::derive_seed(args.seed ^ CALIB_TAG, li as u64),
@@ -294,7 +325,8 @@ pub(super) fn gammas(
         calib_rows(lambda, "calib", &c, calib_csv);
         if calib_check > 0 {
             // the check needs the chosen gamma_1 only; two below it for context
-            let k = false_track_counts(
+            let k = false_track_counts_at(
+                (args.plots, args.tracks),
                 sc,
                 calib_check,
                 faint_core::rng::derive_seed(args.seed ^ CHECK_TAG, li as u64),

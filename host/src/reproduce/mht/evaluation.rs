@@ -7,9 +7,9 @@ use faint_core::detect::Detector;
 
 use super::args::{Args, Sizes};
 use super::calibration::{model_params, proportion_ci, Gammas, GridModel};
-use super::detectors::detectors;
+use super::detectors::{detectors_with, MhtAt};
 use crate::analysis::mht::{self as model, max_count, CellModel, ChainSource, CompoundModel};
-use crate::instances::mht::{Classic, Mht, SCANS};
+use crate::instances::mht::{with_mht_capacity, Classic, SCANS};
 use crate::simulate::mht::{Origin, SeaClutter, Trial};
 
 /// Line-to-truth tolerance (m).
@@ -50,6 +50,14 @@ pub struct TrialStats {
     pub mht_max_count: u8,
     /// Largest classic cell count of the period.
     pub classic_max_count: u8,
+    /// MHT: plots, gated pairs and chains skipped at the detector's capacity (plots
+    /// beyond `PLOTS` per scan, pairs beyond `PLOTS` per scan pair, chains beyond the
+    /// per-scan budget), over the period.
+    #[serde(default)]
+    pub capacity_skips: u32,
+    /// MHT: peaks of the period dropped beyond the track capacity.
+    #[serde(default)]
+    pub peaks_dropped: u32,
 }
 
 fn line_matches(theta: f32, c: f32, trial: &Trial, i: usize, t_scan: f32) -> bool {
@@ -84,17 +92,23 @@ pub fn track_targets(track: &Track<SCANS>, trial: &Trial, t_scan: f32) -> Vec<us
         .collect()
 }
 
-/// Run both detectors on one trial and score them.
-pub fn evaluate_trial(
+/// Run both detectors on one trial and score them (MHT-TBD at any capacity).
+pub fn evaluate_trial<const P: usize, const T: usize>(
     sc: &SeaClutter,
     trial: &Trial,
-    mht: &mut Mht,
+    mht: &mut MhtAt<P, T>,
     classic: &mut Classic,
 ) -> TrialStats {
     let mut st = TrialStats::default();
     let nt = trial.targets.len();
     for scan in &trial.scans {
-        let _ = mht.step(&scan.plots);
+        if let Ok(r) = mht.step(&scan.plots) {
+            let c = &r.censor;
+            st.capacity_skips += r.overflow + c.pair_overflow + c.chain_overflow;
+            if let Some(d) = r.detection {
+                st.peaks_dropped += u32::from(d.condense.dropped);
+            }
+        }
         let _ = classic.step(&scan.plots);
     }
     // censoring statistics (plots are stored in input order: all are in-area)
@@ -205,7 +219,11 @@ pub(super) fn trials(
     let g1u = g1.clamp(1, 255) as u8;
     let gcu = gc.clamp(1, 255) as u8;
     // Surface a configuration error once, before the trials (which cannot report it).
-    detectors(&sc, g1u, gcu).map_err(|e| anyhow::anyhow!("lambda {lambda}: {e}"))?;
+    with_mht_capacity!(args.plots, args.tracks, |P, T| detectors_with::<P, T>(
+        &sc, g1u, gcu
+    )
+    .map(|_| ())
+    .map_err(|e| anyhow::anyhow!("lambda {lambda}: {e}")))?;
     let mut seed = faint_core::rng::derive_seed(args.seed, li as u64);
     let label = if null {
         sc.n_targets = 0;
@@ -214,18 +232,15 @@ pub(super) fn trials(
     } else {
         format!("mht lambda={lambda}")
     };
-    Ok(crate::montecarlo::run_trial_range(
-        seed,
-        range,
-        &label,
-        |_, rng| {
-            let Ok((mut m, mut c)) = detectors(&sc, g1u, gcu) else {
+    Ok(with_mht_capacity!(args.plots, args.tracks, |P, T| {
+        crate::montecarlo::run_trial_range(seed, range, &label, |_, rng| {
+            let Ok((mut m, mut c)) = detectors_with::<P, T>(&sc, g1u, gcu) else {
                 return TrialStats::default();
             };
             let tr = sc.generate(rng);
-            evaluate_trial(&sc, &tr, &mut m, &mut c)
-        },
-    ))
+            evaluate_trial(&sc, &tr, &mut *m, &mut c)
+        })
+    }))
 }
 
 /// Per-lambda summary row.
@@ -271,6 +286,10 @@ pub(super) struct Summary {
     pub(super) check_rate: f64,
     pub(super) check_rate_lo: f64,
     pub(super) check_rate_hi: f64,
+    /// MHT: plots, pairs and chains skipped at capacity, scoring and clutter-only trials.
+    pub(super) capacity_skips: u64,
+    /// MHT: peaks dropped beyond the track capacity, scoring and clutter-only trials.
+    pub(super) peaks_dropped: u64,
 }
 
 /// Clutter-only Pfa row.
@@ -416,5 +435,15 @@ pub(super) fn summarise(
         check_rate_hi: check.as_ref().map_or(f64::NAN, |c| {
             proportion_ci(c.with_track.get(g1).copied().unwrap_or(0), c.periods).2
         }),
+        capacity_skips: res
+            .iter()
+            .chain(nres)
+            .map(|t| u64::from(t.capacity_skips))
+            .sum(),
+        peaks_dropped: res
+            .iter()
+            .chain(nres)
+            .map(|t| u64::from(t.peaks_dropped))
+            .sum(),
     }
 }

@@ -43,10 +43,11 @@ use calibration::{CalibRow, Gammas};
 
 pub use args::{Args, CalibRule, GammaFrom, ModelChoice};
 pub use calibration::{
-    calibrate, false_track_counts, model_params, pilot_floor, proportion_ci, thresholds,
-    thresholds_with, FalseTrackCounts, GridModel, PILOT_PERIODS,
+    calibrate, false_track_counts, false_track_counts_at, model_params, pilot_floor,
+    pilot_floor_at, proportion_ci, thresholds, thresholds_with, FalseTrackCounts, GridModel,
+    PILOT_PERIODS,
 };
-pub use detectors::detectors;
+pub use detectors::{detectors, detectors_with, MhtAt};
 pub use evaluation::{evaluate_trial, target_plots_in, track_targets, TrialStats, MATCH_TOL};
 pub use stages::{attribute, stage3_fates, Fate, Loss, StageReport};
 

@@ -310,6 +310,13 @@ pub(super) fn summary_md(
             s.gamma_classic, s.classic_pd, s.classic_false_peaks, s.classic_trials_with_fa
         );
     }
+    md += &format!(
+        "\nMHT-TBD capacity: {} plots per scan, {} tracks. Skipped at capacity (plots, gated pairs, chains) over the scoring and clutter-only trials, per lambda: {}; peaks dropped beyond the track capacity: {}.\n",
+        args.plots,
+        args.tracks,
+        summaries.iter().map(|s| s.capacity_skips.to_string()).collect::<Vec<_>>().join(" / "),
+        summaries.iter().map(|s| s.peaks_dropped.to_string()).collect::<Vec<_>>().join(" / "),
+    );
     md += "\nModel threshold in clutter-only simulation (largest DMHT count >= gamma_1, before track confirmation; and periods with a confirmed track):\n\n| lambda | gamma_1 | sim grid Pfa [95% CI] | model grid Pfa (eq. 28, N_t = 0) | periods with a confirmed false track | classic sim Pfa at its gamma |\n|---|---|---|---|---|---|\n";
     for s in summaries {
         md += &format!(
