@@ -783,14 +783,17 @@ impl<'a> PowerCube<'a> {
             });
         }
         // One unsigned compare per cell: the bits of a finite `z >= 0` are below those of
-        // `+inf` (`-0.0`, bits `0x8000_0000`, is mapped to 0); the error is told apart
-        // only when there is one.
-        let mut top = 0u32;
-        for &z in data {
-            let b = z.to_bits();
-            top = top.max(if b == 0x8000_0000 { 0 } else { b });
-        }
-        if top >= f32::INFINITY.to_bits() {
+        // `+inf`; so are those of every cell if their largest is. Otherwise `-0.0` (bits
+        // `0x8000_0000`, a valid zero power) may be the only cell above, so the cells are
+        // scanned again for one that is not, and the error told apart.
+        let inf = f32::INFINITY.to_bits();
+        let top = data.iter().fold(0u32, |t, z| t.max(z.to_bits()));
+        if top >= inf
+            && data.iter().any(|z| {
+                let b = z.to_bits();
+                b >= inf && b != 0x8000_0000
+            })
+        {
             if data.iter().any(|z| !z.is_finite()) {
                 return Err(Error::NonFinite);
             }
@@ -1212,6 +1215,15 @@ mod tests {
         assert_eq!(PowerCube::new(&v, g).err(), Some(Error::NonFinite));
         v[7] = -1.0;
         assert_eq!(PowerCube::new(&v, g).err(), Some(Error::NegativeWeight));
+        // -0.0 is a zero power (its bits are above +inf's): alone it passes, beside a bad
+        // cell the error is that cell's.
+        v[7] = -0.0;
+        v[9] = -0.0;
+        assert!(PowerCube::new(&v, g).is_ok());
+        v[3] = -2.0;
+        assert_eq!(PowerCube::new(&v, g).err(), Some(Error::NegativeWeight));
+        v[11] = f32::INFINITY;
+        assert_eq!(PowerCube::new(&v, g).err(), Some(Error::NonFinite));
     }
 
     #[test]
