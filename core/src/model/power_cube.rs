@@ -395,7 +395,7 @@ impl PointSpread {
         let w = self.half(a) as i32;
         // Clamp so that far-away states do not overflow the i32 conversion (i32, not
         // i64: the M4 converts an i64 to f32 in software).
-        let centre = math::floor(frac.clamp(-1.0e6, 1.0e6)) as i32;
+        let centre = floor_i32(frac.clamp(-1.0e6, 1.0e6));
         // The covered cells inside the axis are one run `first..=last`.
         let first = (centre - w).max(0);
         let last = (centre + w).min(n.min(1 << 24) as i32 - 1);
@@ -405,6 +405,34 @@ impl PointSpread {
             if let Some(h) = out.h.get_mut(k) {
                 *h = exp_neg(-half_loss * delta * delta);
                 k += 1;
+            }
+        }
+        out.lo = first.max(0) as usize;
+        out.len = k;
+        out
+    }
+
+    /// [`PointSpread::axis_weights_in`] with `S = 3` for a half width of at most 1, its
+    /// three slots written at constant positions (so that the weights stay in registers):
+    /// the same cells, in the same slots, with the same weights.
+    #[inline(always)]
+    fn axis_weights_3(&self, a: usize, frac: f32, n: usize) -> AxisWeightsN<3> {
+        let mut out = AxisWeightsN::<3>::NONE;
+        if !frac.is_finite() {
+            return out;
+        }
+        let half_loss = 0.5 * self.loss(a);
+        let w = self.half(a) as i32;
+        let centre = floor_i32(frac.clamp(-1.0e6, 1.0e6));
+        let first = (centre - w).max(0);
+        let last = (centre + w).min(n.min(1 << 24) as i32 - 1);
+        let mut k = 0usize;
+        for (slot, h) in out.h.iter_mut().enumerate() {
+            let i = first + slot as i32;
+            if i <= last {
+                let delta = i as f32 + 0.5 - frac;
+                *h = exp_neg(-half_loss * delta * delta);
+                k = slot + 1;
             }
         }
         out.lo = first.max(0) as usize;
@@ -433,6 +461,20 @@ impl PointSpread {
                 }
             }
         }
+    }
+}
+
+/// `floor(x) as i32` for `|x| <= 1e6` (the axis weights' clamped coordinate) without
+/// `math::floor`'s bit manipulation: the conversion truncates toward zero, one less when
+/// that rounded up (a negative non-integer). The same integer as `math::floor(x) as i32`
+/// (`-0.0` gives 0 either way).
+#[inline(always)]
+fn floor_i32(x: f32) -> i32 {
+    let t = x as i32;
+    if t as f32 > x {
+        t - 1
+    } else {
+        t
     }
 }
 
@@ -657,6 +699,7 @@ const fn ln_f64_const(mut y: f64) -> f64 {
 /// absolute error is below `1.6e-5 + 2e-7 ln I0(x)` (tested against an f64 reference).
 /// Negative `x` uses `I0(-x) = I0(x)`; NaN gives NaN.
 #[allow(clippy::excessive_precision)]
+#[inline(never)]
 pub fn log_i0(x: f32) -> f32 {
     let ax = if x < 0.0 { -x } else { x };
     let u = ax * LOG_I0_STEPS_PER_UNIT;
@@ -684,6 +727,27 @@ pub fn log_i0(x: f32) -> f32 {
     }
 }
 
+/// [`log_i0`] with its table branch inlined (the likelihood's per-cell call): the same
+/// bits for every `x`. `|x|` by clearing the sign bit differs from `log_i0`'s `-x` only
+/// for `-0.0` (the table gives `+0.0` from either zero: `0 + (+-0) (b - a)` with
+/// `a = ln I0(0) = 0`) and for NaN, which the table branch never takes; every `x` outside
+/// the table goes to `log_i0` itself. The index is masked to the table's range, which it
+/// already is (`0 <= u < 2048`), so that no bounds check remains.
+#[inline(always)]
+fn log_i0_inline(x: f32) -> f32 {
+    let ax = f32::from_bits(x.to_bits() & 0x7fff_ffff);
+    let u = ax * LOG_I0_STEPS_PER_UNIT;
+    if u < (LOG_I0_ENTRIES - 1) as f32 {
+        let k = u as usize;
+        let f = u - k as f32;
+        let k = k & (LOG_I0_ENTRIES - 2);
+        let (a, b) = (LOG_I0_TABLE[k], LOG_I0_TABLE[k + 1]);
+        a + f * (b - a)
+    } else {
+        log_i0(x)
+    }
+}
+
 /// Log likelihood ratio of one cell's power `z` (Rician with amplitude `mu` over the
 /// noise-only exponential, per-component noise variance `sigma2`):
 /// `ln L(z | x) = -mu^2 / (2 sigma^2) + ln I0(mu sqrt(z) / sigma^2)` (eq. 21-23).
@@ -696,7 +760,7 @@ pub fn cell_log_lr(z: f32, mu: f32, sigma2: f32) -> f32 {
 /// [`cell_log_lr`] with `inv = 1 / sigma^2` and `half_inv = 1 / (2 sigma^2)` hoisted.
 #[inline(always)]
 fn cell_llr(z: f32, mu: f32, inv: f32, half_inv: f32) -> f32 {
-    log_i0(mu * sqrt(z) * inv) - mu * mu * half_inv
+    log_i0_inline(mu * sqrt(z) * inv) - mu * mu * half_inv
 }
 
 /// A validated, borrowed power cube.
@@ -719,14 +783,17 @@ impl<'a> PowerCube<'a> {
             });
         }
         // One unsigned compare per cell: the bits of a finite `z >= 0` are below those of
-        // `+inf` (`-0.0`, bits `0x8000_0000`, is mapped to 0); the error is told apart
-        // only when there is one.
-        let mut top = 0u32;
-        for &z in data {
-            let b = z.to_bits();
-            top = top.max(if b == 0x8000_0000 { 0 } else { b });
-        }
-        if top >= f32::INFINITY.to_bits() {
+        // `+inf`; so are those of every cell if their largest is. Otherwise `-0.0` (bits
+        // `0x8000_0000`, a valid zero power) may be the only cell above, so the cells are
+        // scanned again for one that is not, and the error told apart.
+        let inf = f32::INFINITY.to_bits();
+        let top = data.iter().fold(0u32, |t, z| t.max(z.to_bits()));
+        if top >= inf
+            && data.iter().any(|z| {
+                let b = z.to_bits();
+                b >= inf && b != 0x8000_0000
+            })
+        {
             if data.iter().any(|z| !z.is_finite()) {
                 return Err(Error::NonFinite);
             }
@@ -758,7 +825,7 @@ impl<'a> PowerCube<'a> {
         sigma2: f32,
     ) -> (f32, usize) {
         if psf.half_width.iter().all(|&w| w <= 1) {
-            self.log_lr_argmax_in::<3>(psf, c, amp, sigma2)
+            self.log_lr_argmax_3(psf, c, amp, sigma2)
         } else {
             self.log_lr_argmax_in::<MAX_SPAN>(psf, c, amp, sigma2)
         }
@@ -796,6 +863,114 @@ impl<'a> PowerCube<'a> {
                     s += l;
                     if l > best.1 {
                         best = (base + k, l);
+                    }
+                }
+            }
+        }
+        (s, best.0)
+    }
+
+    /// [`PowerCube::log_lr_argmax_in`] for half widths of at most 1 (three slots per
+    /// axis): the same cells, order and operations, with a row of three azimuth cells
+    /// inside the cube read at once and its three weights kept in registers.
+    #[inline(always)]
+    fn log_lr_argmax_3(
+        &self,
+        psf: &PointSpread,
+        c: &RadarCoords,
+        amp: f32,
+        sigma2: f32,
+    ) -> (f32, usize) {
+        let g = &self.geometry;
+        let (fr, fd, fb) = g.fractional(c);
+        let r = psf.axis_weights_3(0, fr, g.n_range);
+        let d = psf.axis_weights_3(1, fd, g.n_doppler);
+        let b = psf.axis_weights_3(2, fb, g.n_azimuth);
+        let inv = 1.0 / sigma2;
+        let half_inv = 0.5 * inv;
+        let mut s = 0.0f32;
+        let mut best = (usize::MAX, f32::NEG_INFINITY);
+        let hb = b.weights();
+        let [h0, h1, h2] = b.h;
+        let three = hb.len() == 3;
+        if three {
+            // The rows' weights `h_r h_d` and first cells, then the rows: fewer values
+            // live in the cell loop (the same products, rows and order).
+            let mut habs = [0.0f32; 9];
+            let mut bases = [0usize; 9];
+            let mut m = 0usize;
+            for (ir, &hr) in (r.lo..).zip(r.weights()) {
+                for (jd, &hd) in (d.lo..).zip(d.weights()) {
+                    if let (Some(h), Some(o)) = (habs.get_mut(m), bases.get_mut(m)) {
+                        *h = hr * hd;
+                        *o = (ir * g.n_doppler + jd) * g.n_azimuth + b.lo;
+                        m += 1;
+                    }
+                }
+            }
+            for (&hab, &base) in habs.iter().zip(&bases).take(m) {
+                let Some(&[z0, z1, z2]) = self
+                    .data
+                    .get(base..base + 3)
+                    .and_then(|row| <&[f32; 3]>::try_from(row).ok())
+                else {
+                    continue;
+                };
+                let l = cell_llr(z0, amp * (hab * h0), inv, half_inv);
+                s += l;
+                if l > best.1 {
+                    best = (base, l);
+                }
+                let l = cell_llr(z1, amp * (hab * h1), inv, half_inv);
+                s += l;
+                if l > best.1 {
+                    best = (base + 1, l);
+                }
+                let l = cell_llr(z2, amp * (hab * h2), inv, half_inv);
+                s += l;
+                if l > best.1 {
+                    best = (base + 2, l);
+                }
+            }
+            return (s, best.0);
+        }
+        for (ir, &hr) in (r.lo..).zip(r.weights()) {
+            for (jd, &hd) in (d.lo..).zip(d.weights()) {
+                let hab = hr * hd;
+                let base = (ir * g.n_doppler + jd) * g.n_azimuth + b.lo;
+                if three {
+                    let Some(&[z0, z1, z2]) = self
+                        .data
+                        .get(base..base + 3)
+                        .and_then(|row| <&[f32; 3]>::try_from(row).ok())
+                    else {
+                        continue;
+                    };
+                    let l = cell_llr(z0, amp * (hab * h0), inv, half_inv);
+                    s += l;
+                    if l > best.1 {
+                        best = (base, l);
+                    }
+                    let l = cell_llr(z1, amp * (hab * h1), inv, half_inv);
+                    s += l;
+                    if l > best.1 {
+                        best = (base + 1, l);
+                    }
+                    let l = cell_llr(z2, amp * (hab * h2), inv, half_inv);
+                    s += l;
+                    if l > best.1 {
+                        best = (base + 2, l);
+                    }
+                } else {
+                    let Some(row) = self.data.get(base..base + hb.len()) else {
+                        continue;
+                    };
+                    for (k, (&z, &h)) in row.iter().zip(hb).enumerate() {
+                        let l = cell_llr(z, amp * (hab * h), inv, half_inv);
+                        s += l;
+                        if l > best.1 {
+                            best = (base + k, l);
+                        }
                     }
                 }
             }
@@ -965,6 +1140,83 @@ mod tests {
         assert!(sin_cos(f32::NAN).0.is_nan());
     }
 
+    /// The likelihood's inlined and specialised helpers give the bits of the general ones:
+    /// `log_i0_inline` against `log_i0` (a sweep over the table and beyond, both zeros,
+    /// negative, infinite and NaN arguments), `floor_i32` against `math::floor`,
+    /// `axis_weights_3` against `axis_weights_in::<3>`, and `log_lr_argmax` (the
+    /// three-slot path) against the `MAX_SPAN` path on every cell centre and off-centre
+    /// point of a cube, edges included.
+    #[test]
+    fn specialised_likelihood_helpers_are_bit_identical() {
+        let mut x = 0.0f32;
+        while x < 40.0 {
+            for v in [x, -x] {
+                assert_eq!(log_i0_inline(v).to_bits(), log_i0(v).to_bits(), "{v}");
+            }
+            x += 0.000_37;
+        }
+        for v in [
+            0.0,
+            -0.0,
+            31.999_998,
+            32.0,
+            1e30,
+            f32::INFINITY,
+            -f32::INFINITY,
+        ] {
+            assert_eq!(log_i0_inline(v).to_bits(), log_i0(v).to_bits(), "{v}");
+        }
+        assert!(log_i0_inline(f32::NAN).is_nan());
+        let mut f = -1.0e6f32;
+        while f <= 1.0e6 {
+            for v in [f, f + 0.25, f + 0.5, -0.0] {
+                assert_eq!(floor_i32(v), math::floor(v) as i32, "{v}");
+            }
+            f += 997.13;
+        }
+        let g = geom();
+        let data: std::vec::Vec<f32> = (0..g.len())
+            .map(|i| ((i * 7919) % 113) as f32 * 0.37)
+            .collect();
+        let cube = PowerCube::new(&data, g).unwrap();
+        for psf in [
+            PointSpread::ONE_CELL,
+            PointSpread::from_std([0.7, 1.3, 2.0], [1, 0, 1]),
+        ] {
+            let mut k = 0u32;
+            for ir in 0..=2 * g.n_range {
+                for jd in 0..=2 * g.n_doppler {
+                    for lb in 0..=2 * g.n_azimuth {
+                        k = k.wrapping_mul(1_103_515_245).wrapping_add(12345);
+                        let jitter = (k >> 16) as f32 / 65536.0 * 0.5;
+                        let c = RadarCoords {
+                            range: g.range_start + (ir as f32 * 0.5 + jitter) * g.range_cell,
+                            doppler: g.doppler_start + (jd as f32 * 0.5 + jitter) * g.doppler_cell,
+                            azimuth_deg: g.azimuth_start_deg
+                                + (lb as f32 * 0.5 - jitter) * g.azimuth_cell_deg,
+                        };
+                        let (fr, fd, fb) = g.fractional(&c);
+                        for (a, fx, n) in [
+                            (0, fr, g.n_range),
+                            (1, fd, g.n_doppler),
+                            (2, fb, g.n_azimuth),
+                        ] {
+                            assert_eq!(
+                                psf.axis_weights_3(a, fx, n),
+                                psf.axis_weights_in::<3>(a, fx, n)
+                            );
+                        }
+                        for amp in [0.0, 0.8, 3.0, 40.0] {
+                            let (s3, i3) = cube.log_lr_argmax(&psf, &c, amp, 0.5);
+                            let (s17, i17) = cube.log_lr_argmax_in::<MAX_SPAN>(&psf, &c, amp, 0.5);
+                            assert_eq!((s3.to_bits(), i3), (s17.to_bits(), i17), "{c:?} {amp}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn likelihood_ratio_is_one_without_target() {
         assert_eq!(cell_log_lr(3.0, 0.0, 1.0), 0.0);
@@ -1004,6 +1256,15 @@ mod tests {
         assert_eq!(PowerCube::new(&v, g).err(), Some(Error::NonFinite));
         v[7] = -1.0;
         assert_eq!(PowerCube::new(&v, g).err(), Some(Error::NegativeWeight));
+        // -0.0 is a zero power (its bits are above +inf's): alone it passes, beside a bad
+        // cell the error is that cell's.
+        v[7] = -0.0;
+        v[9] = -0.0;
+        assert!(PowerCube::new(&v, g).is_ok());
+        v[3] = -2.0;
+        assert_eq!(PowerCube::new(&v, g).err(), Some(Error::NegativeWeight));
+        v[11] = f32::INFINITY;
+        assert_eq!(PowerCube::new(&v, g).err(), Some(Error::NonFinite));
     }
 
     #[test]

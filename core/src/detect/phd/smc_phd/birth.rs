@@ -242,7 +242,7 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
             self.cfg.psf.peak_radius(1),
             self.cfg.psf.peak_radius(2),
         ];
-        let (h2, wa) = centre_weights(&self.cfg.psf);
+        let (w3, wa) = centre_weights(&self.cfg.psf);
         let data = cube.data();
         let out = self.birth_cells.as_flattened_mut();
         let want = want.min(out.len());
@@ -253,7 +253,7 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
         for ir in 0..g.n_range {
             for jd in 0..g.n_doppler {
                 for lb in 0..g.n_azimuth {
-                    let z = matched(data, &g, &h2, wa, ir, jd, lb);
+                    let z = matched(data, &g, &w3, wa, ir, jd, lb);
                     if n == want && z <= min {
                         continue;
                     }
@@ -360,17 +360,21 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
             g.n_azimuth,
         );
         let data = cube.data();
-        let (h2, wa) = centre_weights(psf);
+        let (w3, wa) = centre_weights(psf);
         let mut n = 0usize;
         // The weakest kept statistic and its slot once `out` is full.
         let mut min = (f32::NEG_INFINITY, 0usize);
         for ir in r0..r1 {
             for jd in 0..g.n_doppler {
+                let rows = interior_rows(data, g, wa, ir, jd);
                 for lb in b0..b1 {
                     let idx = g.index(ir, jd, lb);
                     // Point-spread-matched statistic `sum h^2 z` of a target at the cell
                     // centre, as for the swarm's points.
-                    let z = matched(data, g, &h2, wa, ir, jd, lb);
+                    let z = match rows.as_ref().and_then(|r| line_matched(r, &w3, lb)) {
+                        Some(z) => z,
+                        None => matched(data, g, &w3, wa, ir, jd, lb),
+                    };
                     if n < out.len() {
                         out[n] = (idx, z);
                         n += 1;
@@ -397,11 +401,12 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
     }
 }
 
-/// The squared weights `h^2 = exp(-L delta^2)` of a target at a cell centre on each
-/// axis (`delta = k - w` cells, `k = 0..=2w`) over the central `3 x 3 x 3` cells
-/// ([`PointSpread::central`]), and the half widths: the same for every cell, so computed
-/// once per frame.
-fn centre_weights(psf: &PointSpread) -> ([[f32; 3]; 3], [usize; 3]) {
+/// The products `(h_r^2 h_d^2) h_b^2` of the squared weights `h^2 = exp(-L delta^2)` of a
+/// target at a cell centre (`delta = k - w` cells, `k = 0..=2w` per axis) over the central
+/// `3 x 3 x 3` cells ([`PointSpread::central`]), and the half widths: the same for every
+/// cell, so computed once per frame. Each product is rounded exactly as the statistic's
+/// per-cell `(h_r^2 h_d^2) h_b^2` was, so [`matched`] sums the same terms in the same order.
+fn centre_weights(psf: &PointSpread) -> ([[[f32; 3]; 3]; 3], [usize; 3]) {
     let psf = psf.central();
     let wa = [psf.half(0), psf.half(1), psf.half(2)];
     let mut h2 = [[0.0f32; 3]; 3];
@@ -412,16 +417,26 @@ fn centre_weights(psf: &PointSpread) -> ([[f32; 3]; 3], [usize; 3]) {
             *v = math::exp(-loss * dl * dl);
         }
     }
-    (h2, wa)
+    let mut w = [[[0.0f32; 3]; 3]; 3];
+    for (wr, &hr) in w.iter_mut().zip(&h2[0]) {
+        for (wrd, &hd) in wr.iter_mut().zip(&h2[1]) {
+            let hrd = hr * hd;
+            for (v, &hb) in wrd.iter_mut().zip(&h2[2]) {
+                *v = hrd * hb;
+            }
+        }
+    }
+    (w, wa)
 }
 
 /// The point-spread-matched statistic `sum h^2 z` of a target at the centre of cell
-/// `(ir, jd, lb)` over the in-cube cells of the central spread ([`centre_weights`]).
+/// `(ir, jd, lb)` over the in-cube cells of the central spread ([`centre_weights`]): the
+/// terms `((h_r^2 h_d^2) h_b^2) z` summed in cell order (range, Doppler, azimuth).
 #[inline(always)]
 fn matched(
     data: &[f32],
     g: &CubeGeometry,
-    h2: &[[f32; 3]; 3],
+    w: &[[[f32; 3]; 3]; 3],
     wa: [usize; 3],
     ir: usize,
     jd: usize,
@@ -436,18 +451,108 @@ fn matched(
     let (i0, i1, ki) = span(ir, wa[0], g.n_range);
     let (j0, j1, kj) = span(jd, wa[1], g.n_doppler);
     let (l0, l1, kl) = span(lb, wa[2], g.n_azimuth);
-    let hb = h2[2].get(kl..).unwrap_or(&[]);
     let mut z = 0.0f32;
-    for (i, &hr) in (i0..=i1).zip(h2[0].get(ki..).unwrap_or(&[])) {
-        for (j, &hd) in (j0..=j1).zip(h2[1].get(kj..).unwrap_or(&[])) {
-            let hrd = hr * hd;
+    for (i, wr) in (i0..=i1).zip(w.get(ki..).unwrap_or(&[])) {
+        for (j, wrd) in (j0..=j1).zip(wr.get(kj..).unwrap_or(&[])) {
             let base = (i * g.n_doppler + j) * g.n_azimuth;
             if let Some(row) = data.get(base + l0..=base + l1) {
-                for (&v, &h) in row.iter().zip(hb) {
-                    z += hrd * h * v;
+                for (&v, &h) in row.iter().zip(wrd.get(kl..).unwrap_or(&[])) {
+                    z += h * v;
                 }
             }
         }
     }
     z
+}
+
+/// The nine azimuth rows `(ir - 1 + a, jd - 1 + b)`, `a, b` in `0..3`, around the line
+/// `(ir, jd)` of the cube, each the whole row: for [`line_matched`] on the line's cells
+/// whose `3 x 3 x 3` neighbourhood is inside the cube. `None` unless the spread covers
+/// `3 x 3 x 3` cells and `(ir, jd)` is interior on its two axes.
+#[inline(always)]
+fn interior_rows<'d>(
+    data: &'d [f32],
+    g: &CubeGeometry,
+    wa: [usize; 3],
+    ir: usize,
+    jd: usize,
+) -> Option<[&'d [f32]; 9]> {
+    if wa[0] != 1 || wa[1] != 1 || wa[2] != 1 || ir == 0 || jd == 0 {
+        return None;
+    }
+    if ir + 1 >= g.n_range || jd + 1 >= g.n_doppler {
+        return None;
+    }
+    let n = g.n_azimuth;
+    let mut rows: [&[f32]; 9] = [&[]; 9];
+    for (k, r) in rows.iter_mut().enumerate() {
+        let o = ((ir - 1 + k / 3) * g.n_doppler + (jd - 1 + k % 3)) * n;
+        *r = data.get(o..o + n)?;
+    }
+    Some(rows)
+}
+
+/// [`matched`] of cell `lb` of a line whose [`interior_rows`] are `rows`, for
+/// `1 <= lb < n_azimuth - 1`: the same 27 terms `((h_r^2 h_d^2) h_b^2) z`, summed in the
+/// same order, without the per-cell spans. `None` if `lb` is not interior.
+#[inline(always)]
+fn line_matched(rows: &[&[f32]; 9], w: &[[[f32; 3]; 3]; 3], lb: usize) -> Option<f32> {
+    let l = lb.checked_sub(1)?;
+    let mut z = 0.0f32;
+    for (row, wrd) in rows.iter().zip(w.as_flattened()) {
+        let &[v0, v1, v2] = row.get(l..l + 3)? else {
+            return None;
+        };
+        z += wrd[0] * v0;
+        z += wrd[1] * v1;
+        z += wrd[2] * v2;
+    }
+    Some(z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The per-line interior path gives the bits of the per-cell statistic on every cell
+    /// it covers, and declines the edge cells.
+    #[test]
+    fn line_matched_is_bit_identical_to_matched() {
+        let g = CubeGeometry {
+            n_range: 7,
+            n_doppler: 5,
+            n_azimuth: 9,
+            range_start: 0.0,
+            range_cell: 10.0,
+            doppler_start: -2.0,
+            doppler_cell: 1.0,
+            azimuth_start_deg: 0.0,
+            azimuth_cell_deg: 1.0,
+        };
+        let data: std::vec::Vec<f32> = (0..g.len())
+            .map(|i| ((i * 7919) % 101) as f32 * 0.731)
+            .collect();
+        for psf in [
+            PointSpread::ONE_CELL,
+            PointSpread::from_std([0.8, 1.7, 0.6], [2, 1, 3]),
+            PointSpread::from_std([1.0, 1.0, 1.0], [1, 0, 1]),
+        ] {
+            let (w3, wa) = centre_weights(&psf);
+            let mut fast = 0;
+            for ir in 0..g.n_range {
+                for jd in 0..g.n_doppler {
+                    let rows = interior_rows(&data, &g, wa, ir, jd);
+                    for lb in 0..g.n_azimuth {
+                        let want = matched(&data, &g, &w3, wa, ir, jd, lb);
+                        if let Some(z) = rows.as_ref().and_then(|r| line_matched(r, &w3, lb)) {
+                            assert_eq!(z.to_bits(), want.to_bits(), "{ir} {jd} {lb}");
+                            fast += 1;
+                        }
+                    }
+                }
+            }
+            let interior = if wa == [1, 1, 1] { 5 * 3 * 7 } else { 0 };
+            assert_eq!(fast, interior, "{psf:?}");
+        }
+    }
 }

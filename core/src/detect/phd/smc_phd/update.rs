@@ -6,7 +6,7 @@ use super::*;
 use crate::model::power_cube;
 
 /// The 13 "forward" neighbours of a cell (the other 13 are found from the other side).
-const NEIGHBOURS: [(i64, i64, i64); 13] = [
+const NEIGHBOURS: [(isize, isize, isize); 13] = [
     (0, 0, 1),
     (0, 1, -1),
     (0, 1, 0),
@@ -36,6 +36,88 @@ fn find(parent: &mut [u32], mut r: usize) -> usize {
         r = gp as usize;
     }
     r
+}
+
+/// `order` becomes `0..order.len()` sorted by `(key[i], i)`: the permutation a sort by
+/// that key (unique, as `i` breaks the ties) gives, computed by a stable LSD radix sort
+/// of the indices: the particles outside the cube (`key == u32::MAX`, the largest key)
+/// go last in index order, the others are sorted by their cell in passes of the digits of
+/// `count.len()` (a power of two), `tmp` the other buffer of each pass. Every access is
+/// checked (`order`, `tmp` and `key` hold at least `order.len()` entries).
+fn sort_by_cell(key: &[u32], order: &mut [u32], tmp: &mut [u32], count: &mut [u32]) {
+    let n = order.len().min(tmp.len()).min(key.len());
+    let mut m = 0usize;
+    let mut dead = 0usize;
+    let mut bits = 0u32;
+    for (i, &k) in key.iter().enumerate().take(n) {
+        if k != u32::MAX {
+            if let Some(o) = order.get_mut(m) {
+                *o = i as u32;
+            }
+            m += 1;
+            bits |= k;
+        } else {
+            if let Some(t) = tmp.get_mut(dead) {
+                *t = i as u32;
+            }
+            dead += 1;
+        }
+    }
+    if let (Some(o), Some(t)) = (order.get_mut(m..m + dead), tmp.get(..dead)) {
+        o.copy_from_slice(t);
+    }
+    let digit = count.len().trailing_zeros();
+    if count.is_empty() || digit == 0 || !count.len().is_power_of_two() {
+        return;
+    }
+    let mask = count.len() as u32 - 1;
+    let width = u32::BITS - bits.leading_zeros();
+    let (Some(live), Some(other)) = (order.get_mut(..m), tmp.get_mut(..m)) else {
+        return;
+    };
+    let mut shift = 0u32;
+    let mut in_other = false;
+    while shift < width {
+        if in_other {
+            radix_pass(key, other, live, count, shift, mask);
+        } else {
+            radix_pass(key, live, other, count, shift, mask);
+        }
+        in_other = !in_other;
+        shift += digit;
+    }
+    if in_other {
+        live.copy_from_slice(other);
+    }
+}
+
+/// One stable counting pass of [`sort_by_cell`]: `to` = `from` ordered by the digit
+/// `(key >> shift) & mask`.
+fn radix_pass(key: &[u32], from: &[u32], to: &mut [u32], count: &mut [u32], shift: u32, mask: u32) {
+    let dig = |i: u32| {
+        key.get(i as usize)
+            .map_or(0, |&k| ((k >> shift) & mask) as usize)
+    };
+    count.fill(0);
+    for &i in from {
+        if let Some(c) = count.get_mut(dig(i)) {
+            *c += 1;
+        }
+    }
+    let mut sum = 0u32;
+    for c in count.iter_mut() {
+        let t = *c;
+        *c = sum;
+        sum += t;
+    }
+    for &i in from {
+        if let Some(c) = count.get_mut(dig(i)) {
+            if let Some(t) = to.get_mut(*c as usize) {
+                *t = i;
+            }
+            *c += 1;
+        }
+    }
 }
 
 impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARGETS: usize>
@@ -84,10 +166,16 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
         let g = self.cfg.geometry;
         let n = self.n.min(PARTICLES);
         {
-            let key = &self.key;
-            crate::sort::sort_unstable_by_key(&mut self.order[..n], |&i| {
-                (key.get(i as usize).copied().unwrap_or(u32::MAX), i)
-            });
+            // By `(cell, index)`, the order a sort by that key gives (radix passes of
+            // up to 8 bits; `parent` and `run_key`, written below, are the scratch
+            // buffer and the digit counts).
+            let digits = 1usize << (usize::BITS - 1 - PARTICLES.leading_zeros()).min(8);
+            sort_by_cell(
+                &self.key,
+                &mut self.order[..n],
+                &mut self.parent,
+                self.run_key.get_mut(..digits).unwrap_or(&mut []),
+            );
         }
         let ln_lambda = math::ln(self.cfg.clutter_lambda);
         // Runs of equal cell; `run_of[i]` for every particle (u32::MAX outside).
@@ -122,17 +210,18 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
             for r in 0..nr {
                 let (ir, jd, lb) = g.unindex(self.run_key[r] as usize);
                 for (a, b, c) in NEIGHBOURS {
-                    let (x, y, z) = (ir as i64 + a, jd as i64 + b, lb as i64 + c);
-                    if x < 0
-                        || y < 0
-                        || z < 0
-                        || x >= g.n_range as i64
-                        || y >= g.n_doppler as i64
-                        || z >= g.n_azimuth as i64
-                    {
+                    // `usize` arithmetic (the M4 does `i64` in pairs of registers): a
+                    // step below 0 wraps to a value above every axis length, which the
+                    // validated geometry keeps below 2^32.
+                    let (x, y, z) = (
+                        ir.wrapping_add_signed(a),
+                        jd.wrapping_add_signed(b),
+                        lb.wrapping_add_signed(c),
+                    );
+                    if x >= g.n_range || y >= g.n_doppler || z >= g.n_azimuth {
                         continue;
                     }
-                    let idx = g.index(x as usize, y as usize, z as usize) as u32;
+                    let idx = g.index(x, y, z) as u32;
                     if let Ok(q) = self.run_key[..nr].binary_search(&idx) {
                         let (ra, rb) = (find(&mut self.parent, r), find(&mut self.parent, q));
                         if ra != rb {
@@ -155,7 +244,10 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
                 let root = find(&mut self.parent, r as usize);
                 self.anc[i] = root as u32;
                 if let Some(p) = self.pts.get_mut(root) {
-                    p[0] = p[0].max(self.lw[i]);
+                    // `f32::max` without the library call (the same value: `lw` is never
+                    // NaN, `likelihood` maps NaN to -inf, and `p[0]` starts at -inf).
+                    let l = self.lw[i];
+                    p[0] = if l > p[0] { l } else { p[0] };
                 }
             }
         }
@@ -293,5 +385,44 @@ impl<const PARTICLES: usize, const SWARM: usize, const POINTS: usize, const TARG
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The radix sort gives the permutation of the comparison sort by `(key, index)`:
+    /// random cells (small and full 32-bit ranges), particles outside the cube
+    /// (`u32::MAX`), many ties, digit counts of 2 to 256 slots.
+    #[test]
+    fn sort_by_cell_matches_the_sort_by_key_and_index() {
+        let mut rng = crate::rng::Rng::seed_from_u64(7);
+        for (n, range, digits) in [
+            (0usize, 10u32, 256usize),
+            (1, 10, 256),
+            (2400, 32768, 256),
+            (2400, 5, 256),
+            (1000, u32::MAX, 256),
+            (777, 40000, 16),
+            (300, 1000, 2),
+        ] {
+            let key: std::vec::Vec<u32> = (0..n)
+                .map(|_| {
+                    if rng.below(10) == 0 {
+                        u32::MAX
+                    } else {
+                        ((rng.uniform() as f64) * range as f64) as u32 % range.max(1)
+                    }
+                })
+                .collect();
+            let mut want: std::vec::Vec<u32> = (0..n as u32).collect();
+            crate::sort::sort_unstable_by_key(&mut want, |&i| (key[i as usize], i));
+            let mut order = std::vec![0u32; n];
+            let mut tmp = std::vec![0u32; n];
+            let mut count = std::vec![0u32; digits];
+            sort_by_cell(&key, &mut order, &mut tmp, &mut count);
+            assert_eq!(order, want, "{n} {range} {digits}");
+        }
     }
 }
