@@ -68,16 +68,17 @@ pub mod mht {
     /// Plots per scan of the STM32H743's MHT-TBD (the largest `mht:P` of the firmware's
     /// board-fit matrix that fits the part; `faint reproduce mht --plots 512`).
     pub const BOARD_PLOTS: usize = 512;
-    /// Confirmed tracks of the firmware's MHT-TBD (`--tracks 16`).
-    pub const BOARD_TRACKS: usize = 16;
-    /// The STM32H743's MHT-TBD: the firmware's `MhtTbd<512, 30, 256, 180, 16>`, on the
-    /// host's grid.
-    pub type Board = MhtTbd<BOARD_PLOTS, SCANS, RANGE_CELLS, ANGLE_CELLS, BOARD_TRACKS>;
+    /// A smaller track store (`--tracks 16`): the firmware image's before it moved to
+    /// the host's 32, measured to cost Pd (docs/mht.md, "On the STM32H743").
+    pub const SMALL_TRACKS: usize = 16;
+    /// The STM32H743's MHT-TBD: the firmware's `MhtTbd<512, 30, 256, 180, 32>`, on the
+    /// host's grid (`--plots 512`).
+    pub type Board = MhtTbd<BOARD_PLOTS, SCANS, RANGE_CELLS, ANGLE_CELLS, TRACKS>;
     /// The plot capacities `faint reproduce mht --plots` accepts: the host's and the
     /// board's.
     pub const REPRODUCE_PLOTS: [usize; 2] = [PLOTS, BOARD_PLOTS];
     /// The track capacities `faint reproduce mht --tracks` accepts.
-    pub const REPRODUCE_TRACKS: [usize; 2] = [TRACKS, BOARD_TRACKS];
+    pub const REPRODUCE_TRACKS: [usize; 2] = [TRACKS, SMALL_TRACKS];
 
     // The board instance is the firmware's type and the host's the core's host type.
     const _: fn(faint_core::detect::mht::MhtTbdM4) -> Board = |d| d;
@@ -85,15 +86,15 @@ pub mod mht {
 
     /// Runs `$body` with `$p` and `$t` consts, the plot and track capacities of the
     /// instance with `$plots` plots per scan and `$tracks` tracks ([`BOARD_PLOTS`],
-    /// [`BOARD_TRACKS`]: the board's; any other value: the host's [`PLOTS`], [`TRACKS`]).
+    /// [`SMALL_TRACKS`]: the board's plots, the smaller track store; any other value: the host's [`PLOTS`], [`TRACKS`]).
     /// The one place a capacity picks an instance.
     macro_rules! with_mht_capacity {
         ($plots:expr, $tracks:expr, |$p:ident, $t:ident| $body:expr) => {{
             use $crate::instances::mht as im_;
-            match ($plots == im_::BOARD_PLOTS, $tracks == im_::BOARD_TRACKS) {
+            match ($plots == im_::BOARD_PLOTS, $tracks == im_::SMALL_TRACKS) {
                 (true, true) => {
                     const $p: usize = im_::BOARD_PLOTS;
-                    const $t: usize = im_::BOARD_TRACKS;
+                    const $t: usize = im_::SMALL_TRACKS;
                     $body
                 }
                 (true, false) => {
@@ -103,7 +104,7 @@ pub mod mht {
                 }
                 (false, true) => {
                     const $p: usize = im_::PLOTS;
-                    const $t: usize = im_::BOARD_TRACKS;
+                    const $t: usize = im_::SMALL_TRACKS;
                     $body
                 }
                 (false, false) => {

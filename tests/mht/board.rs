@@ -1,8 +1,8 @@
-//! `faint reproduce mht --plots 512 --tracks 16`: the STM32H743's MHT-TBD (512 plots per
-//! scan, 16 tracks) next to the host's (640, 32). Above 512 plots per scan the board's
-//! instance skips plots and counts them; the host's keeps them.
+//! `faint reproduce mht --plots 512 [--tracks 16]`: the STM32H743's MHT-TBD (512 plots
+//! per scan, 32 tracks) and a smaller track store next to the host's (640, 32). Above 512
+//! plots per scan the board's instance skips plots and counts them; the host's keeps them.
 
-use faint::host::instances::mht::{BOARD_PLOTS, BOARD_TRACKS, PLOTS, TRACKS};
+use faint::host::instances::mht::{BOARD_PLOTS, PLOTS, SMALL_TRACKS, TRACKS};
 use faint::host::reproduce::mht::{detectors, detectors_with, evaluate_trial};
 use faint::host::simulate::mht::SeaClutter;
 use faint::rng::Rng;
@@ -12,7 +12,7 @@ use faint::rng::Rng;
 #[test]
 fn the_board_instance_skips_plots_beyond_512() {
     assert_eq!(
-        (BOARD_PLOTS, BOARD_TRACKS, PLOTS, TRACKS),
+        (BOARD_PLOTS, SMALL_TRACKS, PLOTS, TRACKS),
         (512, 16, 640, 32)
     );
     let sc = SeaClutter::paper(560.0);
@@ -25,8 +25,7 @@ fn the_board_instance_skips_plots_beyond_512() {
     );
     let (mut host, mut classic) = detectors(&sc, 30, 30).unwrap();
     let h = evaluate_trial(&sc, &tr, &mut *host, &mut classic);
-    let (mut board, mut classic) =
-        detectors_with::<BOARD_PLOTS, BOARD_TRACKS>(&sc, 30, 30).unwrap();
+    let (mut board, mut classic) = detectors_with::<BOARD_PLOTS, TRACKS>(&sc, 30, 30).unwrap();
     let b = evaluate_trial(&sc, &tr, &mut *board, &mut classic);
     assert_eq!(h.capacity_skips, 0);
     let beyond: usize = tr.scans.iter().map(|s| s.plots.len() - BOARD_PLOTS).sum();

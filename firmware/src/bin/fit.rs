@@ -258,7 +258,7 @@ mod det {
     #[cfg(faint_fit = "hough")]
     const PLOTS: usize = 512;
     #[cfg(faint_fit = "mht")]
-    type Det = faint_core::detect::mht::MhtTbd<PLOTS, 30, 256, 180, 16>;
+    type Det = faint_core::detect::mht::MhtTbd<PLOTS, 30, 256, 180, 32>;
     #[cfg(faint_fit = "hough")]
     type Det = faint_core::detect::mht::ClassicHough<256, 180, 64>;
     const _: Det = unsafe { MaybeUninit::zeroed().assume_init() };

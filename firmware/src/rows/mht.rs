@@ -18,7 +18,7 @@ use faint_firmware::statics::Static;
 
 const P: usize = 512;
 
-type Det = MhtTbd<P, 30, 256, 180, 16>;
+type Det = MhtTbd<P, 30, 256, 180, 32>;
 
 static DET: Static<Det> = Static::new(Det::new_unconfigured());
 static SCAN: Static<[Plot; P]> = Static::new([Plot::new(0.0, 0.0, 0.0); P]);

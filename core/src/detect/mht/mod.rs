@@ -272,8 +272,9 @@ pub struct MhtReport {
     pub detection: Option<PeriodSummary>,
 }
 
-/// The firmware's detector: 512 plots per scan, 30 scans, a 256 x 180 grid, 16 tracks.
-pub type MhtTbdM4 = MhtTbd<512, 30, 256, 180, 16>;
+/// The firmware's detector: 512 plots per scan, 30 scans, a 256 x 180 grid, 32 tracks
+/// (the host's track store: 16 dropped target peaks and cost Pd, docs/mht.md).
+pub type MhtTbdM4 = MhtTbd<512, 30, 256, 180, 32>;
 /// The host's detector (`faint reproduce mht`, the soak run): 640 plots per scan, 30
 /// scans, a 256 x 180 grid, 32 tracks.
 pub type MhtTbdHost = MhtTbd<640, 30, 256, 180, 32>;

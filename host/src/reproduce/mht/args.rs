@@ -67,14 +67,15 @@ pub struct Args {
     /// simulated; a result at this floor is flagged), 1 to 255.
     #[arg(long, default_value_t = 3)]
     pub calib_min_gamma: u8,
-    /// MHT-TBD's plot capacity per scan: 640 (the host's) or 512 (the STM32H743's; with
-    /// `--tracks 16` the firmware's `MhtTbd<512, 30, 256, 180, 16>`); plots, gated pairs
-    /// and chains beyond it are skipped and counted. Also the calibration's detector.
+    /// MHT-TBD's plot capacity per scan: 640 (the host's) or 512 (the STM32H743's, the
+    /// firmware's `MhtTbd<512, 30, 256, 180, 32>`); plots, gated pairs and chains beyond
+    /// it are skipped and counted. Also the calibration's detector.
     #[arg(long, default_value_t = PLOTS)]
     #[serde(default = "host_plots")]
     pub plots: usize,
-    /// MHT-TBD's track capacity: 32 (the host's) or 16 (the firmware's); peaks beyond it
-    /// are dropped weakest first and counted. Also the calibration's detector.
+    /// MHT-TBD's track capacity: 32 (the host's and the firmware's) or 16 (a smaller
+    /// store, which costs Pd); peaks beyond it are dropped weakest first and counted.
+    /// Also the calibration's detector.
     #[arg(long, default_value_t = TRACKS)]
     #[serde(default = "host_tracks")]
     pub tracks: usize,

@@ -1,6 +1,6 @@
 //! The two detectors of `faint reproduce mht`, built for a scene and its thresholds: the
-//! host's MHT-TBD ([`detectors`]) or, for `--plots 512 --tracks 16`, the STM32H743's
-//! ([`detectors_with`] at the board's capacities).
+//! host's MHT-TBD ([`detectors`]) or, for `--plots 512` and/or `--tracks 16`, the
+//! STM32H743's or a smaller track store ([`detectors_with`] at those capacities).
 
 use faint_core::detect::mht::{ClassicHoughConfig, MhtConfig, MhtTbd};
 
