@@ -892,8 +892,7 @@ impl<'a> PowerCube<'a> {
         let mut best = (usize::MAX, f32::NEG_INFINITY);
         let hb = b.weights();
         let [h0, h1, h2] = b.h;
-        let three = hb.len() == 3;
-        if three {
+        if hb.len() == 3 {
             // The rows' weights `h_r h_d` and first cells, then the rows: fewer values
             // live in the cell loop (the same products, rows and order).
             let mut habs = [0.0f32; 9];
@@ -934,43 +933,19 @@ impl<'a> PowerCube<'a> {
             }
             return (s, best.0);
         }
+        // Rows of fewer than three cells (the azimuth axis's edges).
         for (ir, &hr) in (r.lo..).zip(r.weights()) {
             for (jd, &hd) in (d.lo..).zip(d.weights()) {
                 let hab = hr * hd;
                 let base = (ir * g.n_doppler + jd) * g.n_azimuth + b.lo;
-                if three {
-                    let Some(&[z0, z1, z2]) = self
-                        .data
-                        .get(base..base + 3)
-                        .and_then(|row| <&[f32; 3]>::try_from(row).ok())
-                    else {
-                        continue;
-                    };
-                    let l = cell_llr(z0, amp * (hab * h0), inv, half_inv);
+                let Some(row) = self.data.get(base..base + hb.len()) else {
+                    continue;
+                };
+                for (k, (&z, &h)) in row.iter().zip(hb).enumerate() {
+                    let l = cell_llr(z, amp * (hab * h), inv, half_inv);
                     s += l;
                     if l > best.1 {
-                        best = (base, l);
-                    }
-                    let l = cell_llr(z1, amp * (hab * h1), inv, half_inv);
-                    s += l;
-                    if l > best.1 {
-                        best = (base + 1, l);
-                    }
-                    let l = cell_llr(z2, amp * (hab * h2), inv, half_inv);
-                    s += l;
-                    if l > best.1 {
-                        best = (base + 2, l);
-                    }
-                } else {
-                    let Some(row) = self.data.get(base..base + hb.len()) else {
-                        continue;
-                    };
-                    for (k, (&z, &h)) in row.iter().zip(hb).enumerate() {
-                        let l = cell_llr(z, amp * (hab * h), inv, half_inv);
-                        s += l;
-                        if l > best.1 {
-                            best = (base + k, l);
-                        }
+                        best = (base + k, l);
                     }
                 }
             }
